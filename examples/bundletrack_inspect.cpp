@@ -1,0 +1,87 @@
+// bundletrack_inspect --sequence DIR [--depth-scale S]
+// Loads and preprocesses every frame of a YCBInEOAT-layout sequence and prints what the tracker
+// will see: object mask area, how much of it has depth before and after filtering, normals,
+// object depth and the preprocessing time per frame.
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <iostream>
+#include <string>
+
+#include "bundletrack/io/ycbineoat_sequence.hpp"
+
+namespace bt = bundletrack;
+
+namespace {
+
+double median(std::vector<double> v) {
+  if (v.empty()) return 0.0;
+  std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
+  return v[v.size() / 2];
+}
+
+int usage(const char* program) {
+  std::cerr << "usage: " << program << " --sequence DIR [--depth-scale METRES_PER_UNIT]\n";
+  return 2;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  std::string sequence_dir;
+  bt::io::SequenceSettings settings;
+  for (int i = 1; i < argc; ++i) {
+    const std::string arg = argv[i];
+    if (arg == "--sequence" && i + 1 < argc) {
+      sequence_dir = argv[++i];
+    } else if (arg == "--depth-scale" && i + 1 < argc) {
+      settings.depth_scale = std::stod(argv[++i]);
+    } else {
+      return usage(argv[0]);
+    }
+  }
+  if (sequence_dir.empty()) return usage(argv[0]);
+
+  try {
+    const bt::io::YcbineoatSequence sequence(sequence_dir, settings);
+    const auto& K = sequence.camera();
+    std::printf("sequence   %s\nframes     %zu (%s .. %s), %dx%d\nintrinsics fx %.2f fy %.2f cx %.2f cy %.2f\n",
+                sequence_dir.c_str(), sequence.size(), sequence.frameNames().front().c_str(),
+                sequence.frameNames().back().c_str(), sequence.imageSize().width, sequence.imageSize().height, K.fx,
+                K.fy, K.cx, K.cy);
+    std::printf("truth      %s, model %s\n", sequence.hasGroundTruth() ? "annotated poses" : "none",
+                sequence.hasModel() ? (std::to_string(sequence.modelPoints().size()) + " points").c_str() : "none");
+
+    std::vector<double> area, raw_valid, kept, with_normal, object_depth, milliseconds;
+    std::size_t masked_frames = 0;
+    for (std::size_t i = 0; i < sequence.size(); ++i) {
+      const auto start = std::chrono::steady_clock::now();
+      const bt::RgbdFrame frame = sequence.frame(i);
+      milliseconds.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count());
+      if (frame.mask.empty()) continue;
+      ++masked_frames;
+      const cv::Mat raw = sequence.rawDepth(i);
+      const double n = std::max(1, cv::countNonZero(frame.mask));
+      area.push_back(n);
+      raw_valid.push_back(cv::countNonZero((raw > 0) & frame.mask) / n);
+      kept.push_back(cv::countNonZero((frame.depth > 0) & frame.mask) / n);
+      std::vector<cv::Mat> normal_channels;
+      cv::split(frame.normals, normal_channels);
+      with_normal.push_back(cv::countNonZero((normal_channels[2] != 0) & frame.mask) / n);
+      std::vector<double> depths;
+      for (int v = 0; v < frame.depth.rows; ++v)
+        for (int u = 0; u < frame.depth.cols; ++u)
+          if (frame.mask.at<uchar>(v, u) && frame.depth.at<float>(v, u) > 0) depths.push_back(frame.depth.at<float>(v, u));
+      object_depth.push_back(median(depths));
+    }
+    std::printf("masks      %zu of %zu frames\n", masked_frames, sequence.size());
+    std::printf("per frame (median)   mask %.0f px | depth in mask: raw %.1f%%, after filtering %.1f%% | "
+                "normals %.1f%% | object depth %.3f m | preprocessing %.1f ms\n",
+                median(area), 100 * median(raw_valid), 100 * median(kept), 100 * median(with_normal),
+                median(object_depth), median(milliseconds));
+  } catch (const bt::InputError& error) {
+    std::cerr << "error: " << error.what() << '\n';
+    return 1;
+  }
+  return 0;
+}

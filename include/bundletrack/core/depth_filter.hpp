@@ -1,0 +1,108 @@
+#pragma once
+
+#include <cmath>
+#include <limits>
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+namespace bundletrack {
+
+/// Depth clean-up before anything uses the depth (DESIGN.md section 3, after the original code).
+struct DepthFilterSettings {
+  float min_depth = 0.1f;  ///< metres; closer readings are invalid (below any RGB-D sensor's range)
+  float max_depth = std::numeric_limits<float>::infinity();  ///< metres; farther readings are invalid
+  int erode_radius = 1;  ///< pixels; 1 = 3x3 neighbourhood
+  float erode_depth_diff = 0.001f;  ///< metres; a neighbour farther than this in depth counts against the pixel
+  float erode_ratio = 0.8f;  ///< a pixel is removed when this fraction of its neighbours count against it
+  int smooth_radius = 2;  ///< pixels; 2 = 5x5 window
+  float smooth_sigma = 2.0f;  ///< pixels; spatial Gaussian of the smoothing
+  float smooth_depth_window = 0.01f;  ///< metres; only neighbours this close to the local mean are averaged
+  int smooth_passes = 2;
+};
+
+/// Zero invalid (non-finite, out of range) readings so that 0 is the one invalid value downstream.
+inline void invalidateOutOfRange(cv::Mat& depth, const DepthFilterSettings& s) {
+  depth.forEach<float>([&](float& z, const int*) {
+    if (!std::isfinite(z) || z < s.min_depth || z > s.max_depth) z = 0.0f;
+  });
+}
+
+/// Removes isolated readings and the flying pixels of depth edges: a valid pixel goes when at least
+/// erode_ratio of its neighbours are invalid or differ from it by more than erode_depth_diff.
+inline cv::Mat erodeDepth(const cv::Mat& depth, const DepthFilterSettings& s) {
+  CV_Assert(depth.type() == CV_32FC1);
+  cv::Mat out = depth.clone();
+  const int r = s.erode_radius;
+  const int neighbours = (2 * r + 1) * (2 * r + 1) - 1;
+  out.forEach<float>([&](float& z_out, const int* pos) {
+    const int v = pos[0], u = pos[1];
+    const float z = depth.at<float>(v, u);
+    if (z <= 0.0f || neighbours == 0) return;
+    int against = 0;
+    for (int dv = -r; dv <= r; ++dv) {
+      for (int du = -r; du <= r; ++du) {
+        if (du == 0 && dv == 0) continue;
+        const int vv = v + dv, uu = u + du;
+        const bool inside = vv >= 0 && vv < depth.rows && uu >= 0 && uu < depth.cols;
+        const float zn = inside ? depth.at<float>(vv, uu) : 0.0f;
+        if (zn <= 0.0f || std::abs(zn - z) > s.erode_depth_diff) ++against;
+      }
+    }
+    if (against >= s.erode_ratio * neighbours) z_out = 0.0f;
+  });
+  return out;
+}
+
+/// One pass of edge-preserving smoothing: each valid pixel becomes the Gaussian-weighted mean of
+/// the valid neighbours whose depth lies within smooth_depth_window of the window's mean depth.
+inline cv::Mat smoothDepth(const cv::Mat& depth, const DepthFilterSettings& s) {
+  CV_Assert(depth.type() == CV_32FC1);
+  cv::Mat out = depth.clone();
+  const int r = s.smooth_radius, width = 2 * r + 1;
+  std::vector<float> spatial(std::size_t(width * width));
+  for (int dv = -r; dv <= r; ++dv)
+    for (int du = -r; du <= r; ++du)
+      spatial[std::size_t((dv + r) * width + du + r)] =
+          std::exp(-float(du * du + dv * dv) / (2.0f * s.smooth_sigma * s.smooth_sigma));
+  cv::parallel_for_(cv::Range(0, depth.rows), [&](const cv::Range& rows) {
+    for (int v = rows.start; v < rows.end; ++v) {
+      const int v0 = std::max(0, v - r), v1 = std::min(depth.rows - 1, v + r);
+      for (int u = 0; u < depth.cols; ++u) {
+        if (depth.ptr<float>(v)[u] <= 0.0f) continue;
+        const int u0 = std::max(0, u - r), u1 = std::min(depth.cols - 1, u + r);
+        float sum = 0.0f;
+        int count = 0;
+        for (int vv = v0; vv <= v1; ++vv) {
+          const float* row = depth.ptr<float>(vv);
+          for (int uu = u0; uu <= u1; ++uu)
+            if (row[uu] > 0.0f) sum += row[uu], ++count;
+        }
+        const float mean = sum / float(count);
+        float weighted = 0.0f, weights = 0.0f;
+        for (int vv = v0; vv <= v1; ++vv) {
+          const float* row = depth.ptr<float>(vv);
+          const float* w = &spatial[std::size_t((vv - v + r) * width - u + r)];
+          for (int uu = u0; uu <= u1; ++uu) {
+            if (row[uu] <= 0.0f || std::abs(row[uu] - mean) >= s.smooth_depth_window) continue;
+            weighted += w[uu] * row[uu];
+            weights += w[uu];
+          }
+        }
+        if (weights > 0.0f) out.ptr<float>(v)[u] = weighted / weights;
+      }
+    }
+  });
+  return out;
+}
+
+/// The whole clean-up: range check, erosion, then smooth_passes smoothing passes.
+inline cv::Mat filterDepth(const cv::Mat& raw_depth, const DepthFilterSettings& s) {
+  cv::Mat depth = raw_depth.clone();
+  invalidateOutOfRange(depth, s);
+  depth = erodeDepth(depth, s);
+  for (int pass = 0; pass < s.smooth_passes; ++pass) depth = smoothDepth(depth, s);
+  return depth;
+}
+
+}  // namespace bundletrack
