@@ -71,22 +71,22 @@ inline cv::Mat smoothDepth(const cv::Mat& depth, const DepthFilterSettings& s) {
       for (int u = 0; u < depth.cols; ++u) {
         if (depth.ptr<float>(v)[u] <= 0.0f) continue;
         const int u0 = std::max(0, u - r), u1 = std::min(depth.cols - 1, u + r);
-        float sum = 0.0f;
-        int count = 0;
+        // Invalid readings are exactly 0: they add nothing to the sum and fail the test below,
+        // which keeps the inner loops free of branches.
+        float sum = 0.0f, count = 0.0f;
         for (int vv = v0; vv <= v1; ++vv) {
           const float* row = depth.ptr<float>(vv);
-          for (int uu = u0; uu <= u1; ++uu)
-            if (row[uu] > 0.0f) sum += row[uu], ++count;
+          for (int uu = u0; uu <= u1; ++uu) sum += row[uu], count += float(row[uu] > 0.0f);
         }
-        const float mean = sum / float(count);
+        const float mean = sum / count;
         float weighted = 0.0f, weights = 0.0f;
         for (int vv = v0; vv <= v1; ++vv) {
           const float* row = depth.ptr<float>(vv);
           const float* w = &spatial[std::size_t((vv - v + r) * width - u + r)];
           for (int uu = u0; uu <= u1; ++uu) {
-            if (row[uu] <= 0.0f || std::abs(row[uu] - mean) >= s.smooth_depth_window) continue;
-            weighted += w[uu] * row[uu];
-            weights += w[uu];
+            const float use = float(row[uu] > 0.0f && std::abs(row[uu] - mean) < s.smooth_depth_window);
+            weighted += use * w[uu] * row[uu];
+            weights += use * w[uu];
           }
         }
         if (weights > 0.0f) out.ptr<float>(v)[u] = weighted / weights;
