@@ -1,7 +1,8 @@
-// bundletrack_inspect --sequence DIR [--depth-scale S]
+// bundletrack_inspect --sequence DIR [--depth-scale S] [--overlay DIR [--every N]]
 // Loads and preprocesses every frame of a YCBInEOAT-layout sequence and prints what the tracker
 // will see: object mask area, how much of it has depth before and after filtering, normals,
-// object depth and the preprocessing time per frame.
+// object depth and the preprocessing time per frame. --overlay writes every N-th frame with the
+// annotated pose's axes and the mask outline, to check a dataset's conventions by eye.
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -9,6 +10,7 @@
 #include <string>
 
 #include "bundletrack/io/ycbineoat_sequence.hpp"
+#include "bundletrack/viz/overlay.hpp"
 
 namespace bt = bundletrack;
 
@@ -20,20 +22,35 @@ double median(std::vector<double> v) {
   return v[v.size() / 2];
 }
 
+void writeOverlay(const std::filesystem::path& dir, const bt::io::YcbineoatSequence& sequence,
+                  const bt::RgbdFrame& frame, std::size_t i) {
+  std::filesystem::create_directories(dir);
+  cv::Mat image = frame.color.clone();
+  if (!frame.mask.empty()) bt::viz::drawMaskContour(image, frame.mask, {0, 255, 255});
+  if (sequence.hasGroundTruth()) bt::viz::drawAxes(image, sequence.camera(), sequence.groundTruthPose(i), 0.08);
+  const auto path = dir / (frame.name + ".png");
+  if (!cv::imwrite(path.string(), image)) throw bt::InputError(path, "cannot write image");
+}
+
 int usage(const char* program) {
-  std::cerr << "usage: " << program << " --sequence DIR [--depth-scale METRES_PER_UNIT]\n";
+  std::cerr << "usage: " << program << " --sequence DIR [--depth-scale METRES_PER_UNIT] [--overlay DIR [--every N]]\n";
   return 2;
 }
 
 }  // namespace
 
 int main(int argc, char** argv) {
-  std::string sequence_dir;
+  std::string sequence_dir, overlay_dir;
+  int every = 10;
   bt::io::SequenceSettings settings;
   for (int i = 1; i < argc; ++i) {
     const std::string arg = argv[i];
     if (arg == "--sequence" && i + 1 < argc) {
       sequence_dir = argv[++i];
+    } else if (arg == "--overlay" && i + 1 < argc) {
+      overlay_dir = argv[++i];
+    } else if (arg == "--every" && i + 1 < argc) {
+      every = std::max(1, std::stoi(argv[++i]));
     } else if (arg == "--depth-scale" && i + 1 < argc) {
       settings.depth_scale = std::stod(argv[++i]);
     } else {
@@ -58,6 +75,7 @@ int main(int argc, char** argv) {
       const auto start = std::chrono::steady_clock::now();
       const bt::RgbdFrame frame = sequence.frame(i);
       milliseconds.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count());
+      if (!overlay_dir.empty() && i % std::size_t(every) == 0) writeOverlay(overlay_dir, sequence, frame, i);
       if (frame.mask.empty()) continue;
       ++masked_frames;
       const cv::Mat raw = sequence.rawDepth(i);

@@ -159,7 +159,7 @@ TEST_CASE("bad input raises InputError naming the file and the problem") {
 TEST_CASE("shared real sequences: conventions agree with the ground truth and the object model") {
   const fs::path data = sharedDataDir() / "7scenes_objects";
   if (!fs::is_directory(data)) {
-    MESSAGE("skipped: " << data << " is absent");
+    MESSAGE("SKIPPED: " << data << " is absent");
     return;
   }
   for (const std::string name : {"mug_1", "magazines_1", "container_1"}) {

@@ -1,0 +1,200 @@
+#pragma once
+
+#include <cstdio>
+#include <exception>
+#include <filesystem>
+#include <fstream>
+#include <mutex>
+#include <optional>
+#include <string>
+
+#include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
+
+#include "bundletrack/core/error.hpp"
+#include "bundletrack/io/point_files.hpp"
+#include "bundletrack/io/pose_files.hpp"
+#include "bundletrack/synth/renderer.hpp"
+#include "bundletrack/synth/sensor_model.hpp"
+#include "bundletrack/synth/trajectory.hpp"
+
+namespace bundletrack::synth {
+
+enum class Shape { Box, Cylinder, Mug };
+enum class Motion { HandHeld, CameraOrbit };
+
+struct SyntheticSequenceSettings {
+  int frames = 300;
+  cv::Size image_size{640, 480};
+  PinholeCamerad camera{600.0, 600.0, 319.5, 239.5};
+  Shape shape = Shape::Box;
+  bool textureless = false;  ///< one flat colour instead of the printed texture
+  Motion motion = Motion::HandHeld;
+  double speed = 1.0;  ///< scales the motion's phase rate (see HandHeldMotion)
+  bool occluder = false;  ///< an arm passes between camera and object around the middle frame
+  int motion_blur_samples = 1;  ///< > 1: colour averaged over this many instants of a half-frame exposure
+  SensorSettings sensor;
+  unsigned seed = 1;
+  int model_points = 4000;  ///< surface samples written to model/points.xyz
+};
+
+/// One rendered frame with its exact ground truth.
+struct SyntheticFrame {
+  cv::Mat color;  ///< CV_8UC3 BGR, with sensor noise
+  cv::Mat depth;  ///< CV_32FC1 metres, with the sensor model applied; 0 = no reading
+  cv::Mat mask;  ///< CV_8UC1 255 where the object is the visible surface
+  SE3d T_cam_obj;
+};
+
+/// The scene of a synthetic sequence: object, table, wall, optional occluder and their motion.
+class SyntheticScene {
+ public:
+  static constexpr int kTable = 0, kWall = 1, kObject = 2, kOccluder = 3;
+
+  explicit SyntheticScene(SyntheticSequenceSettings settings)
+      : s_(std::move(settings)),
+        renderer_(s_.camera, s_.image_size),
+        object_mesh_(makeObjectMesh(s_.shape)),
+        occluder_mesh_(makeCylinder(0.035, 0.9, 32)),
+        object_texture_(s_.textureless ? plainTexture({60, 140, 200}) : richTexture(1024, s_.seed)),
+        table_texture_(noiseTexture(512, s_.seed + 11, 0.8)),
+        wall_texture_(richTexture(512, s_.seed + 23)),
+        occluder_texture_(noiseTexture(128, s_.seed + 37, 0.3)) {
+    if (s_.frames <= 0) throw InputError("synthetic sequence", "frames must be positive");
+    if (!(s_.speed > 0.0)) throw InputError("synthetic sequence", "speed must be positive");
+    if (s_.motion_blur_samples < 1) throw InputError("synthetic sequence", "motion_blur_samples must be >= 1");
+  }
+
+  const SyntheticSequenceSettings& settings() const { return s_; }
+  const TriangleMesh& objectMesh() const { return object_mesh_; }
+
+  SE3d T_world_obj(double frame) const {
+    if (s_.motion == Motion::HandHeld) return HandHeldMotion().T_world_obj(frame, s_.speed);
+    return SE3d(SO3d(), Eigen::Vector3d(0.0, 0.0, restingHeight()));
+  }
+
+  SE3d T_world_cam(double frame) const {
+    if (s_.motion == Motion::HandHeld) return HandHeldMotion().T_world_cam;
+    return CameraOrbitMotion().T_world_cam(frame, s_.speed, T_world_obj(frame).translation());
+  }
+
+  SE3d T_cam_obj(double frame) const { return T_world_cam(frame).inverse() * T_world_obj(frame); }
+
+  /// Noise-free render at a (possibly fractional) frame time.
+  RenderBuffers renderClean(double frame, bool with_object = true) const {
+    const SE3d T_cam_world = T_world_cam(frame).inverse();
+    const auto plane = [&](const Eigen::Vector3d& o, const Eigen::Vector3d& u, const Eigen::Vector3d& v, double tile,
+                           const cv::Mat& texture, int label) {
+      return TexturedPlane{T_cam_world * o, T_cam_world.rotation() * u, T_cam_world.rotation() * v, tile, &texture,
+                           label};
+    };
+    const std::vector<TexturedPlane> planes = {
+        plane({0, 0, 0}, Eigen::Vector3d::UnitX(), Eigen::Vector3d::UnitY(), 0.6, table_texture_, kTable),
+        plane({-1.0, 1.0, 1.2}, Eigen::Vector3d::UnitX(), -Eigen::Vector3d::UnitZ(), 2.0, wall_texture_, kWall)};
+    std::vector<MeshInstance> meshes;
+    if (with_object) meshes.push_back({&object_mesh_, &object_texture_, T_cam_obj(frame), kObject});
+    if (const auto T_cam_occluder = occluderPose(frame)) {
+      meshes.push_back({&occluder_mesh_, &occluder_texture_, T_cam_world * *T_cam_occluder, kOccluder});
+    }
+    return renderer_.render(planes, meshes);
+  }
+
+  SyntheticFrame frame(int i) const {
+    RenderBuffers clean = renderClean(i);
+    if (s_.motion_blur_samples > 1) {
+      cv::Mat sum(clean.color.size(), CV_32FC3, cv::Scalar::all(0));
+      for (int k = 0; k < s_.motion_blur_samples; ++k)
+        sum += renderClean(i + 0.5 * (double(k) / (s_.motion_blur_samples - 1) - 0.5)).color;
+      clean.color = sum / double(s_.motion_blur_samples);
+    }
+    SyntheticFrame out;
+    applySensorModel(clean, s_.camera, s_.sensor, s_.seed * 100003u + unsigned(i), out.depth, out.color);
+    out.mask = clean.label == kObject;
+    out.T_cam_obj = T_cam_obj(i);
+    return out;
+  }
+
+ private:
+  static TriangleMesh makeObjectMesh(Shape shape) {
+    switch (shape) {
+      case Shape::Cylinder: return makeCylinder(0.035, 0.11);
+      case Shape::Mug: return makeMug(0.04, 0.095, 0.006);
+      default: return makeBox({0.10, 0.07, 0.16});
+    }
+  }
+
+  double restingHeight() const {
+    double lowest = 0.0;
+    for (const auto& p : object_mesh_.positions) lowest = std::min(lowest, p.z());
+    return -lowest;
+  }
+
+  /// The occluding arm: a vertical cylinder halfway between camera and object that sweeps 50 cm
+  /// sideways over the 40 frames around the middle of the sequence.
+  std::optional<SE3d> occluderPose(double frame) const {
+    const double start = 0.5 * s_.frames - 20.0, duration = 40.0;
+    if (!s_.occluder || frame < start || frame > start + duration) return std::nullopt;
+    const SE3d T_world_cam = this->T_world_cam(frame);
+    const Eigen::Vector3d middle = 0.5 * (T_world_cam.translation() + T_world_obj(frame).translation());
+    const Eigen::Vector3d sideways = T_world_cam.rotation() * Eigen::Vector3d::UnitX();
+    const double progress = (frame - start) / duration;
+    return SE3d(SO3d(), middle + (progress - 0.5) * 0.5 * sideways);
+  }
+
+  SyntheticSequenceSettings s_;
+  Renderer renderer_;
+  TriangleMesh object_mesh_, occluder_mesh_;
+  cv::Mat object_texture_, table_texture_, wall_texture_, occluder_texture_;
+};
+
+namespace detail {
+
+inline void writeImage(const std::filesystem::path& path, const cv::Mat& image) {
+  if (!cv::imwrite(path.string(), image)) throw InputError(path, "cannot write image");
+}
+
+}  // namespace detail
+
+/// Writes frame i of `scene` under root with the name %06d.
+inline void writeFrame(const std::filesystem::path& root, const SyntheticScene& scene, int i) {
+  const SyntheticFrame frame = scene.frame(i);
+  char buffer[16];
+  std::snprintf(buffer, sizeof(buffer), "%06d", i);
+  const std::string name(buffer);
+  cv::Mat depth_mm;
+  frame.depth.convertTo(depth_mm, CV_16UC1, 1000.0);  // rounds to the nearest millimetre
+  detail::writeImage(root / "rgb" / (name + ".png"), frame.color);
+  detail::writeImage(root / "depth" / (name + ".png"), depth_mm);
+  detail::writeImage(root / "masks" / (name + ".png"), frame.mask);
+  io::writePose(root / "annotated_poses" / (name + ".txt"), frame.T_cam_obj);
+}
+
+/// Writes the sequence in the YCBInEOAT layout (rgb/, depth/ uint16 mm, masks/, annotated_poses/,
+/// cam_K.txt, model/points.xyz). Frames are rendered in parallel; the result depends only on the
+/// settings.
+inline void writeSyntheticSequence(const std::filesystem::path& root, const SyntheticSequenceSettings& settings) {
+  const SyntheticScene scene(settings);
+  for (const char* dir : {"rgb", "depth", "masks", "annotated_poses", "model"})
+    std::filesystem::create_directories(root / dir);
+  {
+    std::ofstream K(root / "cam_K.txt");
+    K.precision(10);
+    K << settings.camera.fx << " 0 " << settings.camera.cx << "\n0 " << settings.camera.fy << ' ' << settings.camera.cy
+      << "\n0 0 1\n";
+    if (!K) throw InputError(root / "cam_K.txt", "cannot write file");
+  }
+  io::writePoints(root / "model" / "points.xyz", scene.objectMesh().sampleSurface(settings.model_points, settings.seed));
+  std::mutex error_mutex;
+  std::exception_ptr first_error;
+  cv::parallel_for_(cv::Range(0, settings.frames), [&](const cv::Range& range) {
+    try {
+      for (int i = range.start; i < range.end; ++i) writeFrame(root, scene, i);
+    } catch (...) {
+      const std::lock_guard lock(error_mutex);
+      if (!first_error) first_error = std::current_exception();
+    }
+  });
+  if (first_error) std::rethrow_exception(first_error);
+}
+
+}  // namespace bundletrack::synth
