@@ -1,0 +1,23 @@
+#pragma once
+
+#include <concepts>
+#include <optional>
+#include <vector>
+
+#include "bundletrack/core/rgbd_frame.hpp"
+#include "bundletrack/features/frame_features.hpp"
+#include "bundletrack/features/matching.hpp"
+
+namespace bundletrack {
+
+/// A source of 3-D feature correspondences (paper IV-B): detects features of a frame inside its
+/// object mask, lifted to 3-D, and matches the features of two frames, optionally gated by a known
+/// relative pose. Plug in learned features by providing these two members.
+template <typename T>
+concept CorrespondenceSource = requires(T& source, const T& const_source, const RgbdFrame& frame,
+                                        const FrameFeatures& features, const std::optional<MatchGate>& gate) {
+  { source.detect(frame) } -> std::same_as<FrameFeatures>;
+  { const_source.match(features, features, gate) } -> std::same_as<std::vector<FeatureMatch>>;
+};
+
+}  // namespace bundletrack

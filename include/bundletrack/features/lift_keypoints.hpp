@@ -1,0 +1,66 @@
+#pragma once
+
+#include <cmath>
+#include <vector>
+
+#include <Eigen/Eigenvalues>
+#include <opencv2/core.hpp>
+
+#include "bundletrack/core/rgbd_frame.hpp"
+#include "bundletrack/features/frame_features.hpp"
+
+namespace bundletrack {
+
+/// Unit normal at pixel (u, v) from a plane fit (smallest eigenvector of the covariance) to the
+/// valid points of the (2r+1)^2 window within max_depth_jump of the centre in depth; faces the
+/// camera. Keypoints often sit where the per-pixel normal is undefined (texture edges coincide
+/// with depth noise), and the fit is also less noisy. Returns zero when fewer than 6 points fit.
+inline Eigen::Vector3f fitNormal(const cv::Mat& points, int u, int v, int r, float max_depth_jump) {
+  const cv::Vec3f& c = points.at<cv::Vec3f>(v, u);
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+  Eigen::Matrix3d second = Eigen::Matrix3d::Zero();
+  int count = 0;
+  for (int vv = std::max(0, v - r); vv <= std::min(points.rows - 1, v + r); ++vv) {
+    for (int uu = std::max(0, u - r); uu <= std::min(points.cols - 1, u + r); ++uu) {
+      const cv::Vec3f& p = points.at<cv::Vec3f>(vv, uu);
+      if (p[2] <= 0.0f || std::abs(p[2] - c[2]) > max_depth_jump) continue;
+      const Eigen::Vector3d q(p[0], p[1], p[2]);
+      sum += q;
+      second += q * q.transpose();
+      ++count;
+    }
+  }
+  if (count < 6) return Eigen::Vector3f::Zero();
+  const Eigen::Vector3d mean = sum / count;
+  const Eigen::Matrix3d covariance = second / count - mean * mean.transpose();
+  Eigen::Vector3d n = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(covariance).eigenvectors().col(0);
+  if (n.dot(mean) > 0.0) n = -n;
+  return n.cast<float>();
+}
+
+/// Lifts full-resolution keypoints to 3-D with the frame's depth; keypoints without a valid depth
+/// reading or normal are dropped together with their descriptor row.
+inline FrameFeatures liftKeypoints(const RgbdFrame& frame, const std::vector<cv::Point2f>& pixels,
+                                   const cv::Mat& descriptors, int norm_type, int normal_radius = 3,
+                                   float max_depth_jump = 0.02f) {
+  FrameFeatures features;
+  features.norm_type = norm_type;
+  std::vector<int> kept;
+  for (std::size_t k = 0; k < pixels.size(); ++k) {
+    const int u = int(std::lround(pixels[k].x)), v = int(std::lround(pixels[k].y));
+    if (u < 0 || v < 0 || u >= frame.depth.cols || v >= frame.depth.rows) continue;
+    const cv::Vec3f& p = frame.points.at<cv::Vec3f>(v, u);
+    if (p[2] <= 0.0f) continue;
+    const Eigen::Vector3f n = fitNormal(frame.points, u, v, normal_radius, max_depth_jump);
+    if (n.isZero()) continue;
+    features.pixels.push_back(pixels[k]);
+    features.points.emplace_back(p[0], p[1], p[2]);
+    features.normals.push_back(n);
+    kept.push_back(int(k));
+  }
+  features.descriptors.create(int(kept.size()), descriptors.cols, descriptors.type());
+  for (std::size_t i = 0; i < kept.size(); ++i) descriptors.row(kept[i]).copyTo(features.descriptors.row(int(i)));
+  return features;
+}
+
+}  // namespace bundletrack

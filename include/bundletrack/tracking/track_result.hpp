@@ -1,0 +1,39 @@
+#pragma once
+
+#include <string_view>
+
+#include "bundletrack/core/se3.hpp"
+
+namespace bundletrack {
+
+/// How a frame's pose was obtained.
+enum class TrackStatus {
+  Tracked,  ///< refined by the pose graph (or the first frame)
+  CoarseOnly,  ///< from RANSAC between consecutive frames only
+  Lost,  ///< no trustworthy estimate: the pose is the last good one, flagged, never a silent repeat
+};
+
+inline std::string_view statusName(TrackStatus status) {
+  switch (status) {
+    case TrackStatus::Tracked: return "tracked";
+    case TrackStatus::CoarseOnly: return "coarse";
+    default: return "lost";
+  }
+}
+
+/// Wall-clock milliseconds spent per stage of one frame.
+struct StageTimings {
+  double mask = 0.0, features = 0.0, matching = 0.0, ransac = 0.0, graph = 0.0, solve = 0.0, total = 0.0;
+};
+
+/// The tracker's answer for one frame.
+struct TrackResult {
+  SE3d T_cam_obj;
+  TrackStatus status = TrackStatus::Lost;
+  int keypoints = 0;  ///< features detected on this frame
+  int matches = 0;  ///< matches with the previous frame
+  int inliers = 0;  ///< RANSAC inliers among them
+  StageTimings timings;
+};
+
+}  // namespace bundletrack

@@ -1,0 +1,173 @@
+// Kabsch, RANSAC and matching against exact ground truth.
+#include <doctest/doctest.h>
+
+#include <random>
+
+#include "bundletrack/eval/pose_metrics.hpp"
+#include "bundletrack/features/matching.hpp"
+#include "bundletrack/registration/ransac.hpp"
+
+namespace bt = bundletrack;
+
+namespace {
+
+bt::SE3d randomPose(std::mt19937& rng, double max_angle) {
+  std::normal_distribution<double> normal;
+  const Eigen::Vector3d axis = Eigen::Vector3d(normal(rng), normal(rng), normal(rng)).normalized();
+  std::uniform_real_distribution<double> angle(0.2 * max_angle, max_angle);
+  return bt::SE3d(bt::SO3d::exp(angle(rng) * axis), Eigen::Vector3d(normal(rng), normal(rng), normal(rng)) * 0.1);
+}
+
+// Points on a 10 cm object with unit normals, and their images under T (exact), as FrameFeatures.
+void makeCorrespondingFeatures(std::mt19937& rng, const bt::SE3d& T, int count, bt::FrameFeatures& first,
+                               bt::FrameFeatures& second) {
+  std::uniform_real_distribution<float> coord(-0.05f, 0.05f);
+  std::normal_distribution<float> normal;
+  for (int i = 0; i < count; ++i) {
+    const Eigen::Vector3f p(coord(rng), coord(rng), 0.7f + coord(rng));
+    const Eigen::Vector3f n = Eigen::Vector3f(normal(rng), normal(rng), -3.0f).normalized();
+    first.points.push_back(p);
+    first.normals.push_back(n);
+    second.points.push_back(T.cast<float>() * p);
+    second.normals.push_back(T.rotation().cast<float>() * n);
+  }
+}
+
+std::vector<bt::FeatureMatch> identityMatches(int count) {
+  std::vector<bt::FeatureMatch> matches;
+  for (int i = 0; i < count; ++i) matches.push_back({i, i});
+  return matches;
+}
+
+}  // namespace
+
+TEST_CASE("kabsch recovers a random rigid transform exactly from noise-free points") {
+  std::mt19937 rng(1);
+  for (int trial = 0; trial < 20; ++trial) {
+    const bt::SE3d T = randomPose(rng, 3.1);
+    std::vector<Eigen::Vector3d> a, b;
+    std::normal_distribution<double> normal;
+    for (int i = 0; i < 10; ++i) {
+      a.emplace_back(normal(rng), normal(rng), normal(rng));
+      b.push_back(T * a.back());
+    }
+    const bt::SE3d estimate = bt::kabsch(a, b);
+    CHECK((estimate.matrix() - T.matrix()).cwiseAbs().maxCoeff() < 1e-10);
+  }
+}
+
+TEST_CASE("kabsch returns a rotation, not a reflection, for planar and mirrored input") {
+  // Coplanar points (z = 0) mapped by a rotation: the cross-covariance has rank 2 and a naive
+  // V U^T can have determinant -1.
+  std::vector<Eigen::Vector3d> a = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {1, 1, 0}, {0.3, 0.7, 0}};
+  const bt::SE3d T(bt::SO3d::exp(Eigen::Vector3d(0.3, -0.2, 2.5)), Eigen::Vector3d(0.1, 0.2, 0.3));
+  std::vector<Eigen::Vector3d> b;
+  for (const auto& p : a) b.push_back(T * p);
+  const bt::SE3d estimate = bt::kabsch(a, b);
+  CHECK(estimate.rotationMatrix().determinant() == doctest::Approx(1.0));
+  CHECK((estimate.matrix() - T.matrix()).cwiseAbs().maxCoeff() < 1e-10);
+  // A mirror image cannot be matched by a rotation: the result must still be a proper rotation.
+  std::vector<Eigen::Vector3d> mirrored;
+  for (const auto& p : a) mirrored.emplace_back(p.x(), p.y(), -p.z() + 0.1 * p.x() * p.y());
+  CHECK(bt::kabsch(a, mirrored).rotationMatrix().determinant() == doctest::Approx(1.0));
+}
+
+TEST_CASE("RANSAC recovers the transform within 1 mm and 0.1 degree with 60% outliers") {
+  std::mt19937 rng(2);
+  const bt::SE3d T = randomPose(rng, 0.5);
+  bt::FrameFeatures first, second;
+  makeCorrespondingFeatures(rng, T, 200, first, second);
+  // 0.5 mm of noise on the inliers' targets, then 60% of the matches point at random targets.
+  std::normal_distribution<float> noise(0.0f, 0.0005f);
+  for (auto& p : second.points) p += Eigen::Vector3f(noise(rng), noise(rng), noise(rng));
+  std::vector<bt::FeatureMatch> matches = identityMatches(200);
+  std::uniform_int_distribution<int> any(0, 199);
+  for (int i = 0; i < 120; ++i) matches[i].second = (i + 1 + any(rng) % 198) % 200;  // never itself
+  const bt::RansacResult result = bt::Ransac().estimate(first, second, matches);
+  REQUIRE(result.found());
+  CHECK(bt::translationError(T, result.T_second_first) < 1e-3);
+  CHECK(bt::rotationErrorDeg(T, result.T_second_first) < 0.1);
+  CHECK(result.inliers.size() >= 78);  // the 80 true matches, less any noise beyond 5 mm (none at 0.5 mm)
+  CHECK(result.inliers.size() <= 82);  // random outliers landing within 5 mm by chance are rare
+  CHECK(result.inlierRatio() == doctest::Approx(double(result.inliers.size()) / 200.0));
+  CHECK(result.trials < 2000);  // adaptive: w = 0.4 needs ~105 trials at 99.9%
+}
+
+TEST_CASE("RANSAC is deterministic and independent of parallel scoring") {
+  std::mt19937 rng(3);
+  const bt::SE3d T = randomPose(rng, 0.5);
+  bt::FrameFeatures first, second;
+  makeCorrespondingFeatures(rng, T, 100, first, second);
+  auto matches = identityMatches(100);
+  for (int i = 0; i < 50; ++i) matches[i].second = (i + 7) % 100;
+  bt::RansacSettings serial;
+  serial.parallel = false;
+  const auto a = bt::Ransac().estimate(first, second, matches), b = bt::Ransac(serial).estimate(first, second, matches);
+  CHECK(a.inliers == b.inliers);
+  CHECK(a.trials == b.trials);
+  CHECK((a.T_second_first.matrix() - b.T_second_first.matrix()).norm() == 0.0);
+}
+
+TEST_CASE("the normal check rejects a hypothesis that the distance check alone accepts") {
+  // Two point sets related by T, but the second frame's normals are flipped sideways on half of
+  // the points (as when a match lands on the other side of a thin part): those matches satisfy the
+  // 5 mm distance test under T but not the 45 degree normal test.
+  std::mt19937 rng(4);
+  const bt::SE3d T = randomPose(rng, 0.3);
+  bt::FrameFeatures first, second;
+  makeCorrespondingFeatures(rng, T, 40, first, second);
+  for (int i = 0; i < 20; ++i) second.normals[i] = second.normals[i].unitOrthogonal();  // 90 degrees off
+  const auto matches = identityMatches(40);
+  bt::RansacSettings distance_only;
+  distance_only.inlier_normal_angle_deg = 180.0f;
+  const auto with_normals = bt::Ransac().estimate(first, second, matches);
+  const auto without_normals = bt::Ransac(distance_only).estimate(first, second, matches);
+  CHECK(without_normals.inliers.size() == 40);
+  CHECK(with_normals.inliers.size() == 20);
+  for (const int i : with_normals.inliers) CHECK(i >= 20);
+}
+
+TEST_CASE("RANSAC rejects degenerate input instead of returning a pose") {
+  bt::FrameFeatures first, second;
+  for (int i = 0; i < 30; ++i) {  // collinear points: rotation about the line is unobservable
+    first.points.emplace_back(0.01f * float(i), 0.0f, 0.7f);
+    first.normals.emplace_back(0.0f, 0.0f, -1.0f);
+  }
+  second = first;
+  const auto result = bt::Ransac().estimate(first, second, identityMatches(30));
+  CHECK_FALSE(result.found());
+  CHECK(bt::Ransac().estimate(first, second, identityMatches(2)).trials == 0);
+}
+
+TEST_CASE("mutual matching with the ratio test is symmetric and gated by a known pose") {
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<float> uniform(0.0f, 1.0f);
+  bt::FrameFeatures a, b;
+  a.descriptors.create(60, 16, CV_32F);
+  b.descriptors.create(50, 16, CV_32F);
+  for (int r = 0; r < a.descriptors.rows; ++r)
+    for (int c = 0; c < 16; ++c) a.descriptors.at<float>(r, c) = uniform(rng);
+  // b's first 40 descriptors are noisy copies of a's rows 10..49, the rest random.
+  for (int r = 0; r < b.descriptors.rows; ++r)
+    for (int c = 0; c < 16; ++c)
+      b.descriptors.at<float>(r, c) = r < 40 ? a.descriptors.at<float>(r + 10, c) + 0.02f * uniform(rng) : uniform(rng);
+  for (int i = 0; i < 60; ++i) a.points.emplace_back(0.01f * float(i), 0.0f, 0.7f), a.normals.emplace_back(0, 0, -1);
+  for (int i = 0; i < 50; ++i) b.points.emplace_back(0.01f * float(i + 10), 0.0f, 0.7f), b.normals.emplace_back(0, 0, -1);
+  const bt::MatchSettings settings;
+  const auto forward = bt::matchFeatures(a, b, settings), backward = bt::matchFeatures(b, a, settings);
+  REQUIRE(forward.size() == backward.size());
+  for (std::size_t k = 0; k < forward.size(); ++k) {
+    const bool mirrored = std::find(backward.begin(), backward.end(), bt::FeatureMatch{forward[k].second, forward[k].first}) !=
+                          backward.end();
+    CHECK(mirrored);
+  }
+  int correct = 0;
+  for (const auto& m : forward) correct += m.first == m.second + 10;
+  CHECK(correct >= 38);  // nearly all 40 planted pairs survive ratio and mutual tests
+  CHECK(int(forward.size()) - correct <= 2);
+  // A gate with the true relative pose (identity here) keeps the correct matches; one that is off
+  // by 5 cm removes them all.
+  CHECK(bt::matchFeatures(a, b, settings, bt::MatchGate{bt::SE3f(), 0.02f, 45.0f}).size() == std::size_t(correct));
+  const bt::SE3f shifted(bt::SO3f(), Eigen::Vector3f(0.05f, 0.0f, 0.0f));
+  CHECK(bt::matchFeatures(a, b, settings, bt::MatchGate{shifted, 0.02f, 45.0f}).empty());
+}
