@@ -7,6 +7,8 @@
 #include <iostream>
 #include <string>
 
+#include <unistd.h>
+
 #include "bundletrack/eval/sequence_score.hpp"
 #include "bundletrack/io/ycbineoat_sequence.hpp"
 #include "bundletrack/tracking/coarse_tracker.hpp"
@@ -48,6 +50,7 @@ int run(Tracker tracker, const Options& options) {
       << (scored ? ",rotation_error_deg,translation_error_cm\n" : "\n");
   std::vector<bt::SE3d> truth, estimate;
   int lost = 0;
+  const bool interactive = isatty(fileno(stderr));
   for (std::size_t i = 0; i < sequence.size(); ++i) {
     const bt::RgbdFrame frame = sequence.frame(i);
     if (i > 0 && frame.mask.empty())
@@ -67,11 +70,13 @@ int run(Tracker tracker, const Options& options) {
           << 100.0 * bt::translationError(truth.back(), estimate.back());
     }
     csv << '\n';
-    if (!options.quiet)
-      std::fprintf(stderr, "\rframe %zu/%zu  %-7s  inliers %3d/%-3d  %.1f ms ", i + 1, sequence.size(),
-                   std::string(bt::statusName(result.status)).c_str(), result.inliers, result.matches, t.total);
+    // On a terminal one line updated in place; in a log a line every 50 frames.
+    if (!options.quiet && (interactive || (i + 1) % 50 == 0 || i + 1 == sequence.size()))
+      std::fprintf(stderr, "%sframe %zu/%zu  %-7s  inliers %3d/%-3d  %.1f ms%s", interactive ? "\r" : "", i + 1,
+                   sequence.size(), std::string(bt::statusName(result.status)).c_str(), result.inliers,
+                   result.matches, t.total, interactive ? " " : "\n");
   }
-  if (!options.quiet) std::fprintf(stderr, "\n");
+  if (!options.quiet && interactive) std::fprintf(stderr, "\n");
   std::printf("%s: %zu frames, %d lost; poses in %s\n", options.sequence.string().c_str(), sequence.size(), lost,
               (options.out / "poses").string().c_str());
   if (scored) {
