@@ -11,7 +11,7 @@
 
 #include "bundletrack/eval/sequence_score.hpp"
 #include "bundletrack/io/ycbineoat_sequence.hpp"
-#include "bundletrack/tracking/coarse_tracker.hpp"
+#include "bundletrack/tracker.hpp"
 
 namespace bt = bundletrack;
 namespace fs = std::filesystem;
@@ -20,7 +20,7 @@ namespace {
 
 const char* const kUsage = R"(usage: bundletrack_track --sequence DIR --out DIR [options]
   --features F       sift | orb | akaze (sift)
-  --tracker T        coarse: frame-to-frame RANSAC only (coarse)
+  --tracker T        full: pose graph over keyframes (paper IV) | coarse: frame-to-frame RANSAC only (full)
   --depth-scale S    metres per unit of the depth images (0.001)
   --min-inliers N    fewest RANSAC inliers that count as a pose; fewer: the frame is lost (5)
   --inlier-mm D      RANSAC inlier distance in millimetres (5)
@@ -34,19 +34,18 @@ const char* const kUsage = R"(usage: bundletrack_track --sequence DIR --out DIR 
 
 struct Options {
   fs::path sequence, out;
-  std::string features = "sift", tracker = "coarse";
+  std::string features = "sift", tracker = "full";
   bt::io::SequenceSettings sequence_settings;
-  bt::CoarseTrackerSettings coarse;
+  bt::TrackerSettings tracker_settings;
   bool quiet = false;
 };
 
 template <typename Tracker>
-int run(Tracker tracker, const Options& options) {
-  const bt::io::YcbineoatSequence sequence(options.sequence, options.sequence_settings);
+int run(Tracker tracker, const bt::io::YcbineoatSequence& sequence, const Options& options) {
   fs::create_directories(options.out / "poses");
   std::ofstream csv(options.out / "track.csv");
   const bool scored = sequence.hasGroundTruth() && sequence.hasModel();
-  csv << "frame,status,keypoints,matches,inliers,features_ms,matching_ms,ransac_ms,total_ms"
+  csv << "frame,status,keypoints,matches,inliers,mask_ms,features_ms,matching_ms,ransac_ms,graph_ms,solve_ms,total_ms"
       << (scored ? ",rotation_error_deg,translation_error_cm\n" : "\n");
   std::vector<bt::SE3d> truth, estimate;
   int lost = 0;
@@ -62,7 +61,8 @@ int run(Tracker tracker, const Options& options) {
     bt::io::writePose(options.out / "poses" / (frame.name + ".txt"), result.T_cam_obj);
     const auto& t = result.timings;
     csv << frame.name << ',' << bt::statusName(result.status) << ',' << result.keypoints << ',' << result.matches << ','
-        << result.inliers << ',' << t.features << ',' << t.matching << ',' << t.ransac << ',' << t.total;
+        << result.inliers << ',' << t.mask << ',' << t.features << ',' << t.matching << ',' << t.ransac << ',' << t.graph
+        << ',' << t.solve << ',' << t.total;
     if (scored) {
       truth.push_back(sequence.groundTruthPose(i));
       estimate.push_back(result.T_cam_obj);
@@ -89,7 +89,10 @@ int run(Tracker tracker, const Options& options) {
 
 template <typename Source>
 int runWith(const Options& options) {
-  return run(bt::CoarseTracker<Source>(Source(), options.coarse), options);
+  const bt::io::YcbineoatSequence sequence(options.sequence, options.sequence_settings);
+  if (options.tracker == "coarse") return run(bt::CoarseTracker<Source>(Source(), options.tracker_settings.coarse), sequence, options);
+  using Tracker = bt::Tracker<bt::DefaultEnergy, bt::PCG, Source>;
+  return run(Tracker(sequence.camera().cast<float>(), options.tracker_settings), sequence, options);
 }
 
 }  // namespace
@@ -107,8 +110,8 @@ int main(int argc, char** argv) {
     else if (arg == "--features") options.features = value();
     else if (arg == "--tracker") options.tracker = value();
     else if (arg == "--depth-scale") options.sequence_settings.depth_scale = std::atof(value().c_str());
-    else if (arg == "--min-inliers") options.coarse.min_inliers = std::atoi(value().c_str());
-    else if (arg == "--inlier-mm") options.coarse.ransac.inlier_distance = float(std::atof(value().c_str()) * 1e-3);
+    else if (arg == "--min-inliers") options.tracker_settings.coarse.min_inliers = std::atoi(value().c_str());
+    else if (arg == "--inlier-mm") options.tracker_settings.coarse.ransac.inlier_distance = float(std::atof(value().c_str()) * 1e-3);
     else if (arg == "--quiet") options.quiet = true;
     else if (arg == "--help" || arg == "-h") {
       std::cout << kUsage;
@@ -116,7 +119,7 @@ int main(int argc, char** argv) {
     } else fail("unknown option '" + arg + "'");
   }
   if (options.sequence.empty() || options.out.empty()) fail("--sequence and --out are required");
-  if (options.tracker != "coarse") fail("unknown tracker '" + options.tracker + "'");
+  if (options.tracker != "coarse" && options.tracker != "full") fail("unknown tracker '" + options.tracker + "'");
   try {
     if (options.features == "sift") return runWith<bt::SiftFeatures>(options);
     if (options.features == "orb") return runWith<bt::OrbFeatures>(options);

@@ -1,0 +1,57 @@
+#pragma once
+
+#include <concepts>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "bundletrack/core/camera.hpp"
+#include "bundletrack/features/frame_features.hpp"
+#include "bundletrack/graph/keyframe.hpp"
+#include "bundletrack/robust/losses.hpp"
+
+namespace bundletrack {
+
+/// Everything a residual sees of one edge (i, j) of the pose graph: both nodes with their current
+/// poses, the edge's feature correspondences (first = i, second = j) and the dense grid's camera.
+struct PairInput {
+  const Keyframe& i;
+  const Keyframe& j;
+  const SE3d& T_i;
+  const SE3d& T_j;
+  const std::vector<FeatureMatch>& matches;
+  const PinholeCameraf& grid_camera;
+};
+
+/// The weighted normal equations of one edge over the stacked right perturbations [d_i; d_j]:
+/// H += J^T W J, b += J^T W r, cost += rho, summed over the edge's residuals.
+struct PairSystem {
+  Eigen::Matrix<double, 12, 12> H = Eigen::Matrix<double, 12, 12>::Zero();
+  Eigen::Matrix<double, 12, 1> b = Eigen::Matrix<double, 12, 1>::Zero();
+  double cost = 0.0;
+  int residuals = 0;
+
+  /// Adds an N-dimensional residual r with Jacobians J_i, J_j (N x 6), robustly weighted by `loss`
+  /// and scaled by `weight` (lambda in paper eq. 1).
+  template <int N, typename Loss>
+  void add(const Eigen::Matrix<double, N, 1>& r, const Eigen::Matrix<double, N, 6>& J_i,
+           const Eigen::Matrix<double, N, 6>& J_j, const Loss& loss, double weight) {
+    const LossValue l = loss.evaluate(r.squaredNorm());
+    Eigen::Matrix<double, N, 12> J;
+    J.template leftCols<6>() = J_i;
+    J.template rightCols<6>() = J_j;
+    const double w = weight * l.d_rho;
+    H.noalias() += w * J.transpose() * J;
+    b.noalias() += w * J.transpose() * r;
+    cost += weight * l.rho;
+    ++residuals;
+  }
+};
+
+/// An energy term of the pose graph (paper eq. 2, 3): adds its residuals of one edge to a PairSystem.
+template <typename T>
+concept Residual = requires(const T& residual, const PairInput& input, const HuberLoss& loss, PairSystem& system) {
+  { residual.linearise(input, loss, 1.0, system) } -> std::same_as<void>;
+};
+
+}  // namespace bundletrack
