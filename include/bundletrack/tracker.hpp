@@ -16,6 +16,7 @@
 #include "bundletrack/registration/ransac.hpp"
 #include "bundletrack/residuals/dense_point_to_plane.hpp"
 #include "bundletrack/residuals/feature_point_to_point.hpp"
+#include "bundletrack/solvers/dense_ldlt.hpp"
 #include "bundletrack/solvers/gauss_newton.hpp"
 #include "bundletrack/solvers/pcg.hpp"
 #include "bundletrack/tracking/coarse_tracker.hpp"

@@ -13,7 +13,11 @@ struct DepthFilterSettings {
   float min_depth = 0.1f;  ///< metres; closer readings are invalid (below any RGB-D sensor's range)
   float max_depth = std::numeric_limits<float>::infinity();  ///< metres; farther readings are invalid
   int erode_radius = 1;  ///< pixels; 1 = 3x3 neighbourhood
-  float erode_depth_diff = 0.001f;  ///< metres; a neighbour farther than this in depth counts against the pixel
+  /// metres; a neighbour farther than this in depth counts against the pixel. The original code's
+  /// 1 mm acted on depth stored in whole millimetres, where it means "2 mm or more"; 1.5 mm keeps
+  /// exactly that on millimetre data and does not flag sub-millimetre differences of float depth
+  /// (a Kinect's disparity step is 1.3 mm at 0.7 m: with 1 mm, half of a smooth surface was eroded).
+  float erode_depth_diff = 0.0015f;
   float erode_ratio = 0.8f;  ///< a pixel is removed when this fraction of its neighbours count against it
   int smooth_radius = 2;  ///< pixels; 2 = 5x5 window
   float smooth_sigma = 2.0f;  ///< pixels; spatial Gaussian of the smoothing

@@ -1,0 +1,228 @@
+// Robust losses, residual Jacobians, linear solvers and Gauss-Newton against independent references.
+#include <doctest/doctest.h>
+
+#include <random>
+
+#include "bundletrack/energy.hpp"
+#include "bundletrack/graph/keyframe_pool.hpp"
+#include "bundletrack/residuals/dense_point_to_plane.hpp"
+#include "bundletrack/residuals/feature_point_to_point.hpp"
+#include "bundletrack/solvers/dense_ldlt.hpp"
+#include "bundletrack/solvers/gauss_newton.hpp"
+#include "bundletrack/solvers/pcg.hpp"
+
+namespace bt = bundletrack;
+
+namespace {
+
+bt::SE3d perturbed(const bt::SE3d& T, std::mt19937& rng, double scale) {
+  std::normal_distribution<double> normal(0.0, scale);
+  bt::SE3d::Tangent d;
+  for (int k = 0; k < 6; ++k) d[k] = normal(rng);
+  return T * bt::SE3d::exp(d);
+}
+
+// A keyframe whose grid holds a curved, asymmetric surface patch z = g(x, y) = 6x^2 + 3y^2 + 20xy^2
+// (object frame; no rigid motion maps it onto itself) seen from T_cam_obj, with analytic normals,
+// and features at some of its points.
+bt::Keyframe surfaceKeyframe(int id, const bt::SE3d& T_cam_obj, const bt::PinholeCameraf& grid) {
+  bt::Keyframe k;
+  k.id = id;
+  k.T_cam_obj = T_cam_obj;
+  k.points = cv::Mat(60, 80, CV_32FC3, cv::Scalar::all(0));
+  k.normals = cv::Mat(60, 80, CV_32FC3, cv::Scalar::all(0));
+  // Sampled by casting each grid ray.
+  const bt::SE3d T_obj_cam = T_cam_obj.inverse();
+  for (int v = 0; v < 60; ++v) {
+    for (int u = 0; u < 80; ++u) {
+      const Eigen::Vector3d o = T_obj_cam.translation(), dir = T_obj_cam.rotation() * grid.unproject(u, v, 1.0f).cast<double>();
+      const auto gradient = [](const Eigen::Vector3d& p) {
+        return Eigen::Vector2d(12 * p.x() + 20 * p.y() * p.y(), 6 * p.y() + 40 * p.x() * p.y());
+      };
+      double t = 0.5;  // Newton on f(t) = z(t) - g(x(t), y(t))
+      for (int it = 0; it < 30; ++it) {
+        const Eigen::Vector3d p = o + t * dir;
+        const double f = p.z() - (6 * p.x() * p.x() + 3 * p.y() * p.y() + 20 * p.x() * p.y() * p.y());
+        t -= f / (dir.z() - gradient(p).dot(dir.head<2>()));
+      }
+      const Eigen::Vector3d p = o + t * dir;
+      if (std::abs(p.x()) > 0.08 || std::abs(p.y()) > 0.06) continue;
+      const Eigen::Vector3d n_obj = Eigen::Vector3d(-gradient(p).x(), -gradient(p).y(), 1.0).normalized();
+      Eigen::Vector3d pc = T_cam_obj * p, nc = T_cam_obj.rotation() * n_obj;
+      if (nc.dot(pc) > 0) nc = -nc;
+      k.points.at<cv::Vec3f>(v, u) = cv::Vec3f(float(pc.x()), float(pc.y()), float(pc.z()));
+      k.normals.at<cv::Vec3f>(v, u) = cv::Vec3f(float(nc.x()), float(nc.y()), float(nc.z()));
+      if (u % 7 == 0 && v % 7 == 0) {
+        k.features.points.emplace_back(pc.cast<float>());
+        k.features.normals.emplace_back(nc.cast<float>());
+      }
+    }
+  }
+  return k;
+}
+
+}  // namespace
+
+TEST_CASE_TEMPLATE("robust losses match their formulas and rho' is the derivative of rho", Loss, bt::TrivialLoss,
+                   bt::HuberLoss, bt::CauchyLoss, bt::TukeyLoss) {
+  const Loss loss;
+  for (const double r : {0.0005, 0.003, 0.0049, 0.0051, 0.008, 0.02, 0.1}) {
+    const double s = r * r, h = 1e-9;
+    const bt::LossValue value = loss.evaluate(s);
+    CAPTURE(r);
+    CHECK(value.d_rho == doctest::Approx((loss.evaluate(s + h).rho - loss.evaluate(s - h).rho) / (2 * h)).epsilon(1e-5));
+    CHECK(value.dd_rho ==
+          doctest::Approx((loss.evaluate(s + h).d_rho - loss.evaluate(s - h).d_rho) / (2 * h)).epsilon(1e-4).scale(1e3));
+  }
+  // The weights themselves, by hand: Huber (delta 5 mm) weighs 1 inside, delta / |r| outside.
+  CHECK(bt::HuberLoss{}.evaluate(0.004 * 0.004).d_rho == 1.0);
+  CHECK(bt::HuberLoss{}.evaluate(0.01 * 0.01).d_rho == doctest::Approx(0.5));
+  CHECK(bt::CauchyLoss{}.evaluate(0.005 * 0.005).d_rho == doctest::Approx(0.5));  // 1 / (1 + s / c^2) at s = c^2
+  CHECK(bt::TukeyLoss{}.evaluate(0.005 * 0.005).d_rho == doctest::Approx(0.5625));  // (1 - 1/4)^2 at |r| = c / 2
+  CHECK(bt::TukeyLoss{}.evaluate(0.02 * 0.02).d_rho == 0.0);
+}
+
+TEST_CASE("feature and dense residual Jacobians equal central differences of the residuals") {
+  std::mt19937 rng(3);
+  const bt::PinholeCameraf grid{150.0f, 150.0f, 39.5f, 29.5f};
+  const bt::SE3d T_i(bt::SO3d::exp(Eigen::Vector3d(2.8, 0.1, 0.0)), Eigen::Vector3d(0.0, 0.0, 0.6));
+  const bt::SE3d T_j = T_i * bt::SE3d::exp((bt::SE3d::Tangent() << 0.01, -0.005, 0.0, 0.03, -0.02, 0.05).finished());
+  const bt::Keyframe ki = surfaceKeyframe(0, T_i, grid), kj = surfaceKeyframe(1, T_j, grid);
+  // Feature correspondences: the same object point seen by both (matched by nearest object point).
+  std::vector<bt::FeatureMatch> matches;
+  for (int a = 0; a < int(ki.features.points.size()); ++a) {
+    const Eigen::Vector3d pa = T_i.inverse() * ki.features.points[a].cast<double>();
+    int best = 0;
+    for (int b = 0; b < int(kj.features.points.size()); ++b)
+      if ((T_j.inverse() * kj.features.points[b].cast<double>() - pa).norm() <
+          (T_j.inverse() * kj.features.points[best].cast<double>() - pa).norm())
+        best = b;
+    matches.push_back({a, best});
+  }
+  // Evaluated slightly off the true poses so that residuals are non-zero.
+  const bt::SE3d Ti = perturbed(T_i, rng, 0.002), Tj = perturbed(T_j, rng, 0.002);
+  // The trivial loss makes H = J^T J and b = J^T r, so finite differences of the total cost
+  // 1/2 sum r^2 must equal b, and H must be the Gauss-Newton matrix of the differenced residuals.
+  const auto check = [&](const auto& residual) {
+    const auto cost = [&](const bt::SE3d& A, const bt::SE3d& B) {
+      bt::PairSystem system;
+      residual.linearise(bt::PairInput{ki, kj, A, B, matches, grid}, bt::TrivialLoss{}, 1.0, system);
+      return system;
+    };
+    const bt::PairSystem at = cost(Ti, Tj);
+    REQUIRE(at.residuals > 20);
+    Eigen::Matrix<double, 12, 1> gradient;
+    // A tiny step: projective association rounds to grid cells, and a step that moves a projection
+    // across a cell boundary changes the residual set (expected flips ~ points x step x f / z).
+    const double h = 1e-8;
+    for (int k = 0; k < 12; ++k) {
+      bt::SE3d::Tangent d = bt::SE3d::Tangent::Zero();
+      d[k % 6] = h;
+      const bool first = k < 6;
+      const double plus = cost(first ? Ti * bt::SE3d::exp(d) : Ti, first ? Tj : Tj * bt::SE3d::exp(d)).cost;
+      const double minus = cost(first ? Ti * bt::SE3d::exp(-d) : Ti, first ? Tj : Tj * bt::SE3d::exp(-d)).cost;
+      gradient[k] = (plus - minus) / (2 * h) / 2.0;  // cost = sum r^2, gradient of 1/2 sum r^2
+    }
+    CAPTURE(gradient.transpose());
+    CAPTURE(at.b.transpose());
+    CHECK((gradient - at.b).norm() <= 1e-5 * at.b.norm() + 1e-12);
+    CHECK((at.H - at.H.transpose()).norm() < 1e-12 * at.H.norm());
+  };
+  check(bt::FeaturePointToPoint{});
+  check(bt::DensePointToPlane{});
+}
+
+TEST_CASE("PCG and dense LDLT give the same update on a pose-graph system") {
+  std::mt19937 rng(4);
+  // A 12-node system with the structure of a pose graph: SPD, coupled blocks, strongly varying
+  // scales between translation and rotation.
+  const int n = 6 * 12;
+  Eigen::MatrixXd J = Eigen::MatrixXd::Zero(3 * n, n);
+  std::normal_distribution<double> normal;
+  for (int r = 0; r < J.rows(); ++r) {
+    const int a = (r / 6) % 12, b = (a + 1 + r % 5) % 12;
+    for (int c = 0; c < 6; ++c) {
+      J(r, 6 * a + c) = normal(rng) * (c < 3 ? 1.0 : 0.05);
+      J(r, 6 * b + c) = -normal(rng) * (c < 3 ? 1.0 : 0.05);
+    }
+  }
+  const Eigen::MatrixXd H = J.transpose() * J + 1e-6 * Eigen::MatrixXd::Identity(n, n);
+  Eigen::VectorXd rhs(n);
+  for (int k = 0; k < n; ++k) rhs[k] = normal(rng);
+  Eigen::VectorXd x_pcg, x_ldlt;
+  bt::PCG pcg;
+  pcg.max_iterations = 500;
+  pcg.tolerance = 1e-12;
+  const bt::SolveReport report = pcg.solve(H, rhs, x_pcg);
+  bt::DenseLDLT().solve(H, rhs, x_ldlt);
+  CHECK(report.relative_residual < 1e-10);
+  CHECK((x_pcg - x_ldlt).norm() <= 1e-6 * x_ldlt.norm());
+  // The truncated default (5 iterations) is an approximation: it reduces the residual but stops.
+  Eigen::VectorXd x_short;
+  const bt::SolveReport short_report = bt::PCG{}.solve(H, rhs, x_short);
+  CHECK(short_report.iterations == 5);
+  CHECK(short_report.relative_residual < 1.0);
+}
+
+TEST_CASE("Gauss-Newton brings perturbed poses back to the truth, node 0 fixed") {
+  std::mt19937 rng(5);
+  const bt::PinholeCameraf grid{150.0f, 150.0f, 39.5f, 29.5f};
+  std::vector<bt::SE3d> truth;
+  std::vector<bt::Keyframe> frames;
+  for (int k = 0; k < 4; ++k) {
+    truth.emplace_back(bt::SO3d::exp(Eigen::Vector3d(2.8 + 0.05 * k, 0.04 * k, -0.03 * k)),
+                       Eigen::Vector3d(0.01 * k, -0.005 * k, 0.6 + 0.01 * k));
+    frames.push_back(surfaceKeyframe(k, truth.back(), grid));
+  }
+  // Features correspond by index (the same grid cells see nearby, not identical, points), so only
+  // the dense term is used here; it is exact up to the grid's sampling.
+  const std::vector<bt::FeatureMatch> none;
+  std::vector<const bt::Keyframe*> nodes;
+  std::vector<bt::GraphEdge> edges;
+  for (const auto& f : frames) nodes.push_back(&f);
+  for (int a = 0; a < 4; ++a)
+    for (int b = a + 1; b < 4; ++b) edges.push_back({a, b, &none});
+  std::vector<bt::SE3d> poses = truth;
+  for (int k = 1; k < 4; ++k) poses[k] = perturbed(truth[k], rng, 0.004);
+  using DenseOnly = bt::Energy<bt::Term<bt::DensePointToPlane, bt::HuberLoss>>;
+  bt::GaussNewtonSettings settings;
+  settings.iterations = 15;
+  const auto report = bt::optimizePoseGraph(DenseOnly{}, bt::DenseLDLT{}, nodes, edges, grid, poses, settings);
+  CHECK(report.final_cost < report.initial_cost);
+  CHECK((poses[0].matrix() - truth[0].matrix()).norm() == 0.0);
+  for (int k = 1; k < 4; ++k) {
+    CAPTURE(k);
+    // A paraboloid constrains all six degrees of freedom; residual error comes from the 4 mm grid.
+    CHECK((poses[k].translation() - truth[k].translation()).norm() < 1e-3);
+    CHECK(bt::rotationGeodesic(poses[k].rotation(), truth[k].rotation()) * 180.0 / 3.14159 < 0.2);
+  }
+}
+
+TEST_CASE("keyframe pool: greedy selection keeps frame 0 and follows the geodesic sums; bounded size") {
+  bt::KeyframePool pool(4);
+  const Eigen::Vector3d rotations[4] = {{0, 0, 0}, {0.5, 0, 0}, {0, 0, 0.5}, {0, 0, 0.2}};
+  for (int k = 0; k < 4; ++k) {
+    bt::Keyframe f;
+    f.id = k;
+    f.T_cam_obj = bt::SE3d(bt::SO3d::exp(rotations[k]), Eigen::Vector3d::Zero());
+    pool.add(f);
+  }
+  // Current: 0.3 rad about z. Sums to {current, frame 0}: id1 0.58 + 0.5, id2 0.2 + 0.5, id3 0.1 + 0.2
+  // -> id3; adding the distance to id3: id1 1.08 + 0.54, id2 0.7 + 0.3 -> id2.
+  const auto chosen = pool.select(bt::SO3d::exp(Eigen::Vector3d(0, 0, 0.3)), 3);
+  REQUIRE(chosen.size() == 3);
+  CHECK(pool[chosen[0]].id == 0);
+  CHECK(pool[chosen[1]].id == 3);
+  CHECK(pool[chosen[2]].id == 2);
+  CHECK(pool.select(bt::SO3d(), 10).size() == 4);
+  const double ten_degrees = 10.0 * 3.141592653589793 / 180.0;
+  CHECK(pool.isNovelView(bt::SO3d::exp(Eigen::Vector3d(0, 0, 1.2)), ten_degrees));
+  CHECK_FALSE(pool.isNovelView(bt::SO3d::exp(Eigen::Vector3d(0, 0, 0.62)), ten_degrees));
+  // Full: the most redundant keyframe goes (id 3, 0.2 rad from frame 0), never frame 0 itself.
+  bt::Keyframe extra;
+  extra.id = 9;
+  extra.T_cam_obj = bt::SE3d(bt::SO3d::exp(Eigen::Vector3d(0, 0, 2.0)), Eigen::Vector3d::Zero());
+  CHECK(pool.add(extra) == 3);
+  CHECK(pool.size() == 4);
+  CHECK(pool[0].id == 0);
+}
