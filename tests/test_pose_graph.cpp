@@ -58,6 +58,7 @@ bt::Keyframe surfaceKeyframe(int id, const bt::SE3d& T_cam_obj, const bt::Pinhol
       }
     }
   }
+  bt::indexSurface(k);
   return k;
 }
 

@@ -1,6 +1,7 @@
 #pragma once
 
 #include <string>
+#include <vector>
 
 #include <opencv2/core.hpp>
 
@@ -21,7 +22,16 @@ struct Keyframe {
   FrameFeatures features;
   cv::Mat points;  ///< CV_32FC3, downsampled
   cv::Mat normals;  ///< CV_32FC3, downsampled
+  std::vector<cv::Point> surface;  ///< the grid cells that hold a point (see indexSurface)
 };
+
+/// Lists the grid cells with a point, so that the dense term visits only those.
+inline void indexSurface(Keyframe& keyframe) {
+  keyframe.surface.clear();
+  for (int y = 0; y < keyframe.points.rows; ++y)
+    for (int x = 0; x < keyframe.points.cols; ++x)
+      if (keyframe.points.at<cv::Vec3f>(y, x)[2] > 0.0f) keyframe.surface.emplace_back(x, y);
+}
 
 /// The camera of the downsampled grid: u_full = step * x, so fx' = fx / step and cx' = cx / step.
 inline PinholeCameraf downsampledCamera(const PinholeCameraf& camera, int step) {
@@ -31,7 +41,7 @@ inline PinholeCameraf downsampledCamera(const PinholeCameraf& camera, int step) 
 
 inline Keyframe makeKeyframe(int id, const RgbdFrame& frame, const cv::Mat& mask, FrameFeatures features,
                              const SE3d& T_cam_obj, int step) {
-  Keyframe keyframe{id, frame.name, T_cam_obj, std::move(features), {}, {}};
+  Keyframe keyframe{id, frame.name, T_cam_obj, std::move(features), {}, {}, {}};
   const cv::Size size((frame.points.cols + step - 1) / step, (frame.points.rows + step - 1) / step);
   keyframe.points.create(size, CV_32FC3);
   keyframe.normals.create(size, CV_32FC3);
@@ -44,6 +54,7 @@ inline Keyframe makeKeyframe(int id, const RgbdFrame& frame, const cv::Mat& mask
       keyframe.normals.at<cv::Vec3f>(y, x) = use ? n : cv::Vec3f(0, 0, 0);
     }
   }
+  indexSurface(keyframe);
   return keyframe;
 }
 

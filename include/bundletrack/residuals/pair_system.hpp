@@ -46,6 +46,34 @@ struct PairSystem {
     cost += weight * l.rho;
     ++residuals;
   }
+
+  /// Adds a scalar residual that depends on the relative pose only, so that dr/dd_j = -dr/dd_i:
+  /// one 6x6 outer product serves all four blocks (H_ii = H_jj = -H_ij = w J^T J).
+  template <typename Loss>
+  void addRelative(double r, const Eigen::Matrix<double, 1, 6>& J_i, const Loss& loss, double weight) {
+    const LossValue l = loss.evaluate(r * r);
+    const double w = weight * l.d_rho;
+    relative_H_.noalias() += w * J_i.transpose() * J_i;
+    relative_b_.noalias() += (w * r) * J_i.transpose();
+    cost += weight * l.rho;
+    ++residuals;
+  }
+
+  /// Folds the relative-pose accumulators into H and b; call once after the last addRelative().
+  void finish() {
+    H.topLeftCorner<6, 6>() += relative_H_;
+    H.bottomRightCorner<6, 6>() += relative_H_;
+    H.topRightCorner<6, 6>() -= relative_H_;
+    H.bottomLeftCorner<6, 6>() -= relative_H_;
+    b.head<6>() += relative_b_;
+    b.tail<6>() -= relative_b_;
+    relative_H_.setZero();
+    relative_b_.setZero();
+  }
+
+ private:
+  Eigen::Matrix<double, 6, 6> relative_H_ = Eigen::Matrix<double, 6, 6>::Zero();
+  Eigen::Matrix<double, 6, 1> relative_b_ = Eigen::Matrix<double, 6, 1>::Zero();
 };
 
 /// An energy term of the pose graph (paper eq. 2, 3): adds its residuals of one edge to a PairSystem.

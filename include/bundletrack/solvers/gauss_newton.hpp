@@ -2,6 +2,8 @@
 
 #include <vector>
 
+#include <opencv2/core.hpp>
+
 #include "bundletrack/energy.hpp"
 #include "bundletrack/solvers/linear_solver.hpp"
 
@@ -38,15 +40,26 @@ OptimizationReport optimizePoseGraph(const EnergyT& energy, const Solver& solver
   const int n = 6 * free_nodes;
   Eigen::MatrixXd H(n, n);
   Eigen::VectorXd b(n), delta(n);
+  std::vector<PairSystem> pairs(edges.size());
   for (int iteration = 0; iteration < settings.iterations; ++iteration) {
     H.setZero();
     b.setZero();
     double cost = 0.0;
     int residuals = 0;
-    for (const GraphEdge& edge : edges) {
-      PairSystem pair;
-      energy.linearise(PairInput{*nodes[edge.i], *nodes[edge.j], poses[edge.i], poses[edge.j], *edge.matches, grid_camera},
-                       pair);
+    // Edges linearise independently (in parallel); the scatter below is serial and ordered, so the
+    // result does not depend on the thread schedule.
+    cv::parallel_for_(cv::Range(0, int(edges.size())), [&](const cv::Range& range) {
+      for (int e = range.start; e < range.end; ++e) {
+        const GraphEdge& edge = edges[std::size_t(e)];
+        pairs[std::size_t(e)] = PairSystem();
+        energy.linearise(
+            PairInput{*nodes[edge.i], *nodes[edge.j], poses[edge.i], poses[edge.j], *edge.matches, grid_camera},
+            pairs[std::size_t(e)]);
+      }
+    });
+    for (std::size_t e = 0; e < edges.size(); ++e) {
+      const GraphEdge& edge = edges[e];
+      const PairSystem& pair = pairs[e];
       cost += pair.cost;
       residuals += pair.residuals;
       const int index[2] = {edge.i - 1, edge.j - 1};  // node 0 is fixed: it has no unknowns
