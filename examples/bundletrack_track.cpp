@@ -2,6 +2,7 @@
 // Tracks the object of a YCBInEOAT-layout sequence from its first mask and pose; writes
 // OUT/poses/<frame>.txt (4x4 T_cam_obj) and OUT/track.csv, and prints the accuracy when the
 // sequence has ground truth and a model.
+#include <cmath>
 #include <cstdio>
 #include <fstream>
 #include <iostream>
@@ -10,7 +11,7 @@
 #include <unistd.h>
 
 #include "bundletrack/eval/sequence_score.hpp"
-#include "bundletrack/io/ycbineoat_sequence.hpp"
+#include "bundletrack/io/config.hpp"
 #include "bundletrack/tracker.hpp"
 
 namespace bt = bundletrack;
@@ -19,6 +20,8 @@ namespace fs = std::filesystem;
 namespace {
 
 const char* const kUsage = R"(usage: bundletrack_track --sequence DIR --out DIR [options]
+  --config FILE      YAML settings over the defaults (see --print-config); options below override it
+  --print-config     print the effective configuration as YAML and exit
   --features F       sift | orb | akaze (sift)
   --tracker T        full: pose graph over keyframes (paper IV) | coarse: frame-to-frame RANSAC only (full)
   --depth-scale S    metres per unit of the depth images (0.001)
@@ -32,11 +35,20 @@ const char* const kUsage = R"(usage: bundletrack_track --sequence DIR --out DIR 
   std::exit(2);
 }
 
+double number(const std::string& option, const std::string& text) {
+  try {
+    std::size_t used = 0;
+    const double value = std::stod(text, &used);
+    if (used == text.size() && std::isfinite(value)) return value;
+  } catch (const std::exception&) {
+  }
+  fail(option + " expects a number, got '" + text + "'");
+}
+
 struct Options {
-  fs::path sequence, out;
-  std::string features = "sift", tracker = "full";
-  bt::io::SequenceSettings sequence_settings;
-  bt::TrackerSettings tracker_settings;
+  fs::path sequence, out, config_file;
+  std::string tracker = "full";
+  bt::io::Config config;
   bool quiet = false;
 };
 
@@ -88,17 +100,20 @@ int run(Tracker tracker, const bt::io::YcbineoatSequence& sequence, const Option
 }
 
 template <typename Source>
-int runWith(const Options& options) {
-  const bt::io::YcbineoatSequence sequence(options.sequence, options.sequence_settings);
-  if (options.tracker == "coarse") return run(bt::CoarseTracker<Source>(Source(), options.tracker_settings.coarse), sequence, options);
+int runWith(const Options& options, const typename Source::Settings& source_settings) {
+  const bt::io::YcbineoatSequence sequence(options.sequence, options.config.sequence);
+  const bt::TrackerSettings& settings = options.config.tracker;
+  if (options.tracker == "coarse") return run(bt::CoarseTracker<Source>(Source(source_settings), settings.coarse), sequence, options);
   using Tracker = bt::Tracker<bt::DefaultEnergy, bt::PCG, Source>;
-  return run(Tracker(sequence.camera().cast<float>(), options.tracker_settings), sequence, options);
+  return run(Tracker(sequence.camera().cast<float>(), settings, {}, {}, Source(source_settings)), sequence, options);
 }
 
 }  // namespace
 
 int main(int argc, char** argv) {
   Options options;
+  bool print_config = false;
+  std::vector<std::pair<std::string, std::string>> overrides;
   for (int i = 1; i < argc; ++i) {
     const std::string arg = argv[i];
     const auto value = [&]() -> std::string {
@@ -107,24 +122,36 @@ int main(int argc, char** argv) {
     };
     if (arg == "--sequence") options.sequence = value();
     else if (arg == "--out") options.out = value();
-    else if (arg == "--features") options.features = value();
     else if (arg == "--tracker") options.tracker = value();
-    else if (arg == "--depth-scale") options.sequence_settings.depth_scale = std::atof(value().c_str());
-    else if (arg == "--min-inliers") options.tracker_settings.coarse.min_inliers = std::atoi(value().c_str());
-    else if (arg == "--inlier-mm") options.tracker_settings.coarse.ransac.inlier_distance = float(std::atof(value().c_str()) * 1e-3);
+    else if (arg == "--config") options.config_file = value();
+    else if (arg == "--print-config") print_config = true;
+    else if (arg == "--features" || arg == "--depth-scale" || arg == "--min-inliers" || arg == "--inlier-mm")
+      overrides.emplace_back(arg, value());
     else if (arg == "--quiet") options.quiet = true;
     else if (arg == "--help" || arg == "-h") {
       std::cout << kUsage;
       return 0;
     } else fail("unknown option '" + arg + "'");
   }
-  if (options.sequence.empty() || options.out.empty()) fail("--sequence and --out are required");
-  if (options.tracker != "coarse" && options.tracker != "full") fail("unknown tracker '" + options.tracker + "'");
   try {
-    if (options.features == "sift") return runWith<bt::SiftFeatures>(options);
-    if (options.features == "orb") return runWith<bt::OrbFeatures>(options);
-    if (options.features == "akaze") return runWith<bt::AkazeFeatures>(options);
-    fail("unknown features '" + options.features + "'");
+    if (!options.config_file.empty()) options.config = bt::io::loadConfig(options.config_file);
+    auto& config = options.config;
+    for (const auto& [option, text] : overrides) {
+      if (option == "--features") config.features = text;
+      else if (option == "--depth-scale") config.sequence.depth_scale = number(option, text);
+      else if (option == "--min-inliers") config.tracker.coarse.min_inliers = int(number(option, text));
+      else if (option == "--inlier-mm") config.tracker.coarse.ransac.inlier_distance = float(number(option, text) * 1e-3);
+    }
+    if (print_config) {
+      std::cout << bt::io::printConfig(config);
+      return 0;
+    }
+    if (options.sequence.empty() || options.out.empty()) fail("--sequence and --out are required");
+    if (options.tracker != "coarse" && options.tracker != "full") fail("unknown tracker '" + options.tracker + "'");
+    if (config.features == "sift") return runWith<bt::SiftFeatures>(options, config.sift);
+    if (config.features == "orb") return runWith<bt::OrbFeatures>(options, config.orb);
+    if (config.features == "akaze") return runWith<bt::AkazeFeatures>(options, config.akaze);
+    fail("unknown features '" + config.features + "'");
   } catch (const std::exception& error) {
     std::cerr << "\nerror: " << error.what() << '\n';
     return 1;
