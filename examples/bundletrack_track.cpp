@@ -10,8 +10,11 @@
 
 #include <unistd.h>
 
-#include "bundletrack/eval/sequence_score.hpp"
+#include "bundletrack/eval/score_table.hpp"
 #include "bundletrack/io/config.hpp"
+#include "bundletrack/viz/overlay.hpp"
+
+#include <opencv2/videoio.hpp>
 #include "bundletrack/tracker.hpp"
 
 namespace bt = bundletrack;
@@ -27,6 +30,9 @@ const char* const kUsage = R"(usage: bundletrack_track --sequence DIR --out DIR 
   --depth-scale S    metres per unit of the depth images (0.001)
   --min-inliers N    fewest RANSAC inliers that count as a pose; fewer: the frame is lost (5)
   --inlier-mm D      RANSAC inlier distance in millimetres (5)
+  --viz              write OUT/overlay.mp4 (pose axes, object box, mask outline per frame; an image
+                     strip OUT/overlay_strip.png always, and in place of the video where no encoder
+                     is available) and, with ground truth, OUT/errors.png (errors over time)
   --quiet            no progress line
 )";
 
@@ -50,6 +56,55 @@ struct Options {
   std::string tracker = "full";
   bt::io::Config config;
   bool quiet = false;
+  bool viz = false;
+};
+
+/// The overlays of --viz: a video when an encoder is available, and a strip of six frames.
+class OverlayWriter {
+ public:
+  OverlayWriter(const fs::path& out, const bt::io::YcbineoatSequence& sequence)
+      : out_(out), camera_(sequence.camera()), frames_(sequence.size()) {
+    if (sequence.hasModel()) box_ = bt::ObjectBox::bounding(sequence.modelPoints());
+    video_.open((out / "overlay.mp4").string(), cv::VideoWriter::fourcc('m', 'p', '4', 'v'), 10.0, sequence.imageSize());
+  }
+
+  void add(std::size_t i, const bt::RgbdFrame& frame, const bt::TrackResult& result) {
+    cv::Mat image = frame.color.clone();
+    if (!frame.mask.empty()) bt::viz::drawMaskContour(image, frame.mask, {0, 255, 255});
+    double axis = 0.05;
+    if (box_) {
+      bt::viz::drawBox(image, camera_, result.T_cam_obj, *box_, {0, 220, 0}, 2);
+      axis = 0.6 * (box_->max - box_->min).maxCoeff();
+    }
+    bt::viz::drawAxes(image, camera_, result.T_cam_obj, axis);
+    const bool lost = result.status == bt::TrackStatus::Lost;
+    cv::putText(image, frame.name + "  " + std::string(bt::statusName(result.status)), {10, 25},
+                cv::FONT_HERSHEY_SIMPLEX, 0.7, lost ? cv::Scalar(0, 0, 255) : cv::Scalar(255, 255, 255), 2, cv::LINE_AA);
+    if (video_.isOpened()) video_.write(image);
+    if (i % std::max<std::size_t>(1, frames_ / 6) == 0 && strip_.size() < 6) {
+      cv::Mat half;
+      cv::resize(image, half, {}, 0.5, 0.5, cv::INTER_AREA);
+      strip_.push_back(half);
+    }
+  }
+
+  /// Writes the strip; returns what a user should open.
+  std::string finish() {
+    cv::Mat strip;
+    cv::hconcat(strip_, strip);
+    const fs::path strip_path = out_ / "overlay_strip.png";
+    if (!cv::imwrite(strip_path.string(), strip)) throw bt::InputError(strip_path, "cannot write image");
+    return video_.isOpened() ? (out_ / "overlay.mp4").string() + " (and " + strip_path.string() + ")"
+                             : strip_path.string() + " (no video encoder available)";
+  }
+
+ private:
+  fs::path out_;
+  bt::PinholeCamerad camera_;
+  std::size_t frames_;
+  std::optional<bt::ObjectBox> box_;
+  cv::VideoWriter video_;
+  std::vector<cv::Mat> strip_;
 };
 
 template <typename Tracker>
@@ -62,6 +117,9 @@ int run(Tracker tracker, const bt::io::YcbineoatSequence& sequence, const Option
   std::vector<bt::SE3d> truth, estimate;
   int lost = 0;
   const bool interactive = isatty(fileno(stderr));
+  std::optional<OverlayWriter> overlay;
+  if (options.viz) overlay.emplace(options.out, sequence);
+  std::vector<double> rotation_errors, translation_errors;
   for (std::size_t i = 0; i < sequence.size(); ++i) {
     const bt::RgbdFrame frame = sequence.frame(i);
     if (i > 0 && frame.mask.empty())
@@ -78,9 +136,11 @@ int run(Tracker tracker, const bt::io::YcbineoatSequence& sequence, const Option
     if (scored) {
       truth.push_back(sequence.groundTruthPose(i));
       estimate.push_back(result.T_cam_obj);
-      csv << ',' << bt::rotationErrorDeg(truth.back(), estimate.back()) << ','
-          << 100.0 * bt::translationError(truth.back(), estimate.back());
+      rotation_errors.push_back(bt::rotationErrorDeg(truth.back(), estimate.back()));
+      translation_errors.push_back(100.0 * bt::translationError(truth.back(), estimate.back()));
+      csv << ',' << rotation_errors.back() << ',' << translation_errors.back();
     }
+    if (overlay) overlay->add(i, frame, result);
     csv << '\n';
     // On a terminal one line updated in place; in a log a line every 50 frames.
     if (!options.quiet && (interactive || (i + 1) % 50 == 0 || i + 1 == sequence.size()))
@@ -92,9 +152,18 @@ int run(Tracker tracker, const bt::io::YcbineoatSequence& sequence, const Option
   std::printf("%s: %zu frames, %d lost; poses in %s\n", options.sequence.string().c_str(), sequence.size(), lost,
               (options.out / "poses").string().c_str());
   if (scored) {
-    const bt::SequenceScore s = bt::scoreSequence(sequence.modelPoints(), truth, estimate);
-    std::printf("ADD AUC %.2f  ADD-S AUC %.2f  5deg5cm %.1f%%  R_err %.2f deg  T_err %.2f cm  final ADD %.2f cm\n",
-                s.add_auc, s.adds_auc, s.deg5cm5, s.rotation_error_deg, s.translation_error_cm, s.final_add_cm);
+    const bt::SequenceScore score = bt::scoreSequence(sequence.modelPoints(), truth, estimate);
+    std::printf("%s", bt::formatScoreTable({{options.sequence.filename().string(), score}}).c_str());
+    std::printf("final-frame ADD %.2f cm\n", score.final_add_cm);
+  }
+  if (overlay) {
+    std::printf("overlay: %s\n", overlay->finish().c_str());
+    if (scored) {
+      const fs::path plot = options.out / "errors.png";
+      cv::imwrite(plot.string(), bt::viz::plotSeries(rotation_errors, "rotation error [deg]", translation_errors,
+                                                     "translation error [cm]"));
+      std::printf("error plot: %s\n", plot.string().c_str());
+    }
   }
   return 0;
 }
@@ -128,6 +197,7 @@ int main(int argc, char** argv) {
     else if (arg == "--features" || arg == "--depth-scale" || arg == "--min-inliers" || arg == "--inlier-mm")
       overrides.emplace_back(arg, value());
     else if (arg == "--quiet") options.quiet = true;
+    else if (arg == "--viz") options.viz = true;
     else if (arg == "--help" || arg == "-h") {
       std::cout << kUsage;
       return 0;

@@ -3,7 +3,7 @@
 
 #include <random>
 
-#include "bundletrack/eval/pose_metrics.hpp"
+#include "bundletrack/eval/sequence_score.hpp"
 
 namespace bt = bundletrack;
 
@@ -49,4 +49,33 @@ TEST_CASE("k-d tree nearest neighbour equals brute force") {
     for (const auto& p : points) best = std::min(best, (p - query).squaredNorm());
     REQUIRE(tree.nearestSquaredDistance(query) == best);
   }
+}
+
+TEST_CASE("oriented box IoU on hand-computed configurations") {
+  const bt::ObjectBox cube{Eigen::Vector3d(-0.05, -0.05, -0.05), Eigen::Vector3d(0.05, 0.05, 0.05)};
+  const bt::SE3d A(bt::SO3d::exp(Eigen::Vector3d(0.3, -0.2, 0.1)), Eigen::Vector3d(0.1, 0.0, 0.7));
+  CHECK(bt::boxIoU(cube, A, A) == doctest::Approx(1.0).epsilon(1e-9));
+  // Shifted by half its side along its own x: intersection V/2, union 3V/2.
+  CHECK(bt::boxIoU(cube, A, A * bt::SE3d(bt::SO3d(), Eigen::Vector3d(0.05, 0, 0))) == doctest::Approx(1.0 / 3.0).epsilon(0.01));
+  // A cube turned by 90 degrees about an axis is itself.
+  CHECK(bt::boxIoU(cube, A, A * bt::SE3d(bt::SO3d::exp(Eigen::Vector3d(0, 0, 1.5707963267948966)), {0, 0, 0})) ==
+        doctest::Approx(1.0).epsilon(0.01));
+  // Turned by 45 degrees about z: the intersection is a regular octagon prism, area 2 (sqrt 2 - 1) s^2
+  // of the square's s^2 = 0.8284 V; IoU = 0.8284 / (2 - 0.8284) = 0.7071.
+  CHECK(bt::boxIoU(cube, A, A * bt::SE3d(bt::SO3d::exp(Eigen::Vector3d(0, 0, 0.7853981633974483)), {0, 0, 0})) ==
+        doctest::Approx(0.7071).epsilon(0.01));
+  CHECK(bt::boxIoU(cube, A, A * bt::SE3d(bt::SO3d(), Eigen::Vector3d(0.2, 0, 0))) == 0.0);
+}
+
+TEST_CASE("frames without an estimate count as failures") {
+  std::vector<Eigen::Vector3f> model = {{0.05f, 0, 0}, {0, 0.05f, 0}, {0, 0, 0.05f}, {-0.05f, 0, 0}};
+  const bt::SE3d T(bt::SO3d(), Eigen::Vector3d(0, 0, 0.7));
+  const std::vector<bt::SE3d> truth(4, T);
+  const std::vector<std::optional<bt::SE3d>> estimate = {T, std::nullopt, T, std::nullopt};
+  const bt::SequenceScore score = bt::scoreSequence(model, truth, estimate);
+  CHECK(score.missing == 2);
+  CHECK(score.add_auc == doctest::Approx(50.0));  // half the frames perfect, half failed
+  CHECK(score.deg5cm5 == doctest::Approx(50.0));
+  CHECK(score.iou25 == doctest::Approx(50.0));
+  CHECK(score.rotation_error_deg == 0.0);  // mean over the frames that have a pose
 }

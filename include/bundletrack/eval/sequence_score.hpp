@@ -1,7 +1,10 @@
 #pragma once
 
+#include <limits>
+#include <optional>
 #include <vector>
 
+#include "bundletrack/eval/box_iou.hpp"
 #include "bundletrack/eval/pose_metrics.hpp"
 
 namespace bundletrack {
@@ -11,33 +14,54 @@ struct SequenceScore {
   double add_auc = 0.0;  ///< ADD AUC on [0, 10 cm], x100
   double adds_auc = 0.0;  ///< ADD-S AUC on [0, 10 cm], x100
   double deg5cm5 = 0.0;  ///< % of frames with rotation error < 5 deg and translation error < 5 cm
-  double rotation_error_deg = 0.0;  ///< mean
-  double translation_error_cm = 0.0;  ///< mean
-  double final_add_cm = 0.0;  ///< ADD of the last frame: the drift at the end
+  double iou25 = 0.0;  ///< % of frames whose posed model boxes overlap by IoU > 25%
+  double rotation_error_deg = 0.0;  ///< mean over frames with a pose
+  double translation_error_cm = 0.0;  ///< mean over frames with a pose
+  double final_add_cm = 0.0;  ///< ADD of the last frame: the drift at the end (inf when it has no pose)
   int frames = 0;
+  int missing = 0;  ///< frames without an estimate: failures for every rate and AUC above
 };
 
+/// Scores estimates against the truth; a frame without an estimate counts as a failure.
 inline SequenceScore scoreSequence(const std::vector<Eigen::Vector3f>& model, const std::vector<SE3d>& truth,
-                                   const std::vector<SE3d>& estimate) {
+                                   const std::vector<std::optional<SE3d>>& estimate) {
   SequenceScore score;
   score.frames = int(truth.size());
   if (truth.empty()) return score;
   const KdTree3 tree(model);
+  const ObjectBox box = ObjectBox::bounding(model);
+  constexpr double inf = std::numeric_limits<double>::infinity();
   std::vector<double> add, adds;
-  int good = 0;
+  int good = 0, overlapping = 0, present = 0;
   for (std::size_t i = 0; i < truth.size(); ++i) {
-    add.push_back(averageDistance(model, truth[i], estimate[i]));
-    adds.push_back(averageDistanceSymmetric(model, tree, truth[i], estimate[i]));
-    const double r = rotationErrorDeg(truth[i], estimate[i]), t = translationError(truth[i], estimate[i]);
+    if (!estimate[i]) {
+      ++score.missing;
+      add.push_back(inf);
+      adds.push_back(inf);
+      continue;
+    }
+    const SE3d& T = *estimate[i];
+    add.push_back(averageDistance(model, truth[i], T));
+    adds.push_back(averageDistanceSymmetric(model, tree, truth[i], T));
+    const double r = rotationErrorDeg(truth[i], T), t = translationError(truth[i], T);
     good += r < 5.0 && t < 0.05;
-    score.rotation_error_deg += r / double(truth.size());
-    score.translation_error_cm += 100.0 * t / double(truth.size());
+    overlapping += boxIoU(box, truth[i], T) > 0.25;
+    score.rotation_error_deg += r;
+    score.translation_error_cm += 100.0 * t;
+    ++present;
   }
+  if (present > 0) score.rotation_error_deg /= present, score.translation_error_cm /= present;
   score.add_auc = areaUnderCurve(add);
   score.adds_auc = areaUnderCurve(adds);
   score.deg5cm5 = 100.0 * good / double(truth.size());
+  score.iou25 = 100.0 * overlapping / double(truth.size());
   score.final_add_cm = 100.0 * add.back();
   return score;
+}
+
+inline SequenceScore scoreSequence(const std::vector<Eigen::Vector3f>& model, const std::vector<SE3d>& truth,
+                                   const std::vector<SE3d>& estimate) {
+  return scoreSequence(model, truth, std::vector<std::optional<SE3d>>(estimate.begin(), estimate.end()));
 }
 
 }  // namespace bundletrack

@@ -47,6 +47,7 @@ class YcbineoatSequence {
     const auto first_mask = mask(0);
     if (!first_mask) throw InputError(maskPath(0), "the first frame needs an object mask: file not found");
     if (cv::countNonZero(*first_mask) == 0) throw InputError(maskPath(0), "the first frame's object mask is empty");
+    checkDepthScale(*first_mask);
   }
 
   std::size_t size() const { return names_.size(); }
@@ -122,6 +123,28 @@ class YcbineoatSequence {
     }
     names_ = std::move(names);
     color_files_ = std::move(files);
+  }
+
+  /// The commonest mistake with a new dataset is the depth unit: the object's median depth in the
+  /// first frame must lie between 5 cm and 20 m, the range of any RGB-D sensor.
+  void checkDepthScale(const cv::Mat& first_mask) const {
+    const cv::Mat depth = rawDepth(0);
+    std::vector<float> values;
+    for (int v = 0; v < depth.rows; ++v)
+      for (int u = 0; u < depth.cols; ++u)
+        if (first_mask.at<uchar>(v, u) && depth.at<float>(v, u) > 0.0f) values.push_back(depth.at<float>(v, u));
+    const auto path = root_ / "depth" / (names_[0] + ".png");
+    if (values.empty()) throw InputError(path, "no valid depth under the first frame's object mask");
+    std::nth_element(values.begin(), values.begin() + std::ptrdiff_t(values.size() / 2), values.end());
+    const double median = values[values.size() / 2], scale = settings_.depth_scale;
+    const std::string stated = "median object depth is " + std::to_string(median) + " m with depth scale " +
+                               std::to_string(scale) + " m/unit";
+    if (median < 0.05)
+      throw InputError(path, stated + ": closer than any RGB-D sensor measures; the depth scale is probably too small"
+                                      " (images in millimetres need 0.001, in 0.1 mm 0.0001)");
+    if (median > 20.0)
+      throw InputError(path, stated + ": farther than any RGB-D sensor measures; the depth scale is probably too large"
+                                      " (images in millimetres need 0.001, not 1)");
   }
 
   void requireSize(const cv::Mat& image, const std::filesystem::path& path) const {

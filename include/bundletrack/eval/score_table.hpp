@@ -1,0 +1,74 @@
+#pragma once
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include "bundletrack/core/error.hpp"
+#include "bundletrack/eval/sequence_score.hpp"
+
+namespace bundletrack {
+
+struct NamedScore {
+  std::string sequence;
+  SequenceScore score;
+};
+
+/// The mean of each column over the sequences (frames and missing are summed), like the paper's tables.
+inline SequenceScore meanScore(const std::vector<NamedScore>& rows) {
+  SequenceScore mean;
+  for (const auto& [name, s] : rows) {
+    mean.add_auc += s.add_auc, mean.adds_auc += s.adds_auc, mean.deg5cm5 += s.deg5cm5, mean.iou25 += s.iou25;
+    mean.rotation_error_deg += s.rotation_error_deg, mean.translation_error_cm += s.translation_error_cm;
+    mean.final_add_cm += s.final_add_cm, mean.frames += s.frames, mean.missing += s.missing;
+  }
+  const double n = rows.empty() ? 1.0 : double(rows.size());
+  mean.add_auc /= n, mean.adds_auc /= n, mean.deg5cm5 /= n, mean.iou25 /= n;
+  mean.rotation_error_deg /= n, mean.translation_error_cm /= n, mean.final_add_cm /= n;
+  return mean;
+}
+
+inline std::string formatScoreTable(const std::vector<NamedScore>& rows) {
+  std::string out;
+  char line[256];
+  std::snprintf(line, sizeof(line), "%-24s %7s %7s %8s %7s %8s %8s %7s %8s\n", "sequence", "ADD", "ADD-S", "5deg5cm",
+                "IoU25", "R_err", "T_err", "frames", "missing");
+  out += line;
+  const auto row = [&](const std::string& name, const SequenceScore& s) {
+    std::snprintf(line, sizeof(line), "%-24s %7.2f %7.2f %7.1f%% %6.1f%% %6.2fdg %6.2fcm %7d %8d\n", name.c_str(),
+                  s.add_auc, s.adds_auc, s.deg5cm5, s.iou25, s.rotation_error_deg, s.translation_error_cm, s.frames,
+                  s.missing);
+    out += line;
+  };
+  for (const auto& r : rows) row(r.sequence, r.score);
+  if (rows.size() > 1) row("mean", meanScore(rows));
+  return out;
+}
+
+/// JSON with one object per sequence and the mean: ADD, ADD_S, deg5cm5, IoU25, Rerr_deg, Terr_cm, frames.
+inline void writeScoreJson(const std::filesystem::path& path, const std::vector<NamedScore>& rows) {
+  std::ofstream out(path);
+  if (!out) throw InputError(path, "cannot write file");
+  const auto number = [](double v) { return std::isfinite(v) ? std::to_string(v) : std::string("null"); };
+  const auto object = [&](const std::string& name, const SequenceScore& s) {
+    std::string escaped;
+    for (const char c : name) {
+      if (c == '"' || c == '\\') escaped += '\\';
+      escaped += c;
+    }
+    return "{\"sequence\": \"" + escaped + "\", \"ADD\": " + number(s.add_auc) + ", \"ADD_S\": " + number(s.adds_auc) +
+           ", \"deg5cm5\": " + number(s.deg5cm5) + ", \"IoU25\": " + number(s.iou25) +
+           ", \"Rerr_deg\": " + number(s.rotation_error_deg) + ", \"Terr_cm\": " + number(s.translation_error_cm) +
+           ", \"frames\": " + std::to_string(s.frames) + ", \"missing\": " + std::to_string(s.missing) + "}";
+  };
+  out << "{\n  \"sequences\": [\n";
+  for (std::size_t k = 0; k < rows.size(); ++k)
+    out << "    " << object(rows[k].sequence, rows[k].score) << (k + 1 < rows.size() ? ",\n" : "\n");
+  out << "  ],\n  \"mean\": " << object("mean", meanScore(rows)) << "\n}\n";
+  if (!out) throw InputError(path, "write failed");
+}
+
+}  // namespace bundletrack
