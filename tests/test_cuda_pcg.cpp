@@ -1,35 +1,12 @@
 // The GPU PCG policy against its CPU twin on the same systems; skips without a CUDA device.
 #include <doctest/doctest.h>
 
-#include <random>
-
 #include "bundletrack/cuda/pcg.hpp"
 #include "bundletrack/solvers/dense_ldlt.hpp"
 #include "bundletrack/solvers/pcg.hpp"
+#include "pose_graph_system.hpp"
 
 namespace bt = bundletrack;
-
-namespace {
-
-// A pose-graph-shaped SPD system of `nodes` free nodes (coupled 6x6 blocks, mixed scales).
-void poseGraphSystem(int nodes, unsigned seed, Eigen::MatrixXd& H, Eigen::VectorXd& rhs) {
-  std::mt19937 rng(seed);
-  std::normal_distribution<double> normal;
-  const int n = 6 * nodes;
-  Eigen::MatrixXd J = Eigen::MatrixXd::Zero(3 * n, n);
-  for (int r = 0; r < J.rows(); ++r) {
-    const int a = (r / 6) % nodes, b = (a + 1 + r % 5) % nodes;
-    for (int c = 0; c < 6; ++c) {
-      J(r, 6 * a + c) += normal(rng) * (c < 3 ? 1.0 : 0.05);
-      J(r, 6 * b + c) -= normal(rng) * (c < 3 ? 1.0 : 0.05);
-    }
-  }
-  H = J.transpose() * J + 1e-3 * Eigen::MatrixXd::Identity(n, n);
-  rhs.resize(n);
-  for (int k = 0; k < n; ++k) rhs[k] = normal(rng);
-}
-
-}  // namespace
 
 static_assert(bt::LinearSolver<bt::cuda::PCG>, "the GPU PCG composes like the CPU one");
 
@@ -42,7 +19,7 @@ TEST_CASE("GPU PCG equals CPU PCG (same iterations) and converges to the dense s
     CAPTURE(nodes);
     Eigen::MatrixXd H;
     Eigen::VectorXd rhs, x_cpu, x_gpu, x_dense;
-    poseGraphSystem(nodes, unsigned(nodes), H, rhs);
+    poseGraphSystem(nodes, unsigned(nodes), 1e-3, H, rhs);
     // The tracker's truncated solve: 5 iterations on both sides, compared step for step.
     const bt::SolveReport cpu = bt::PCG{}.solve(H, rhs, x_cpu);
     const bt::SolveReport gpu = bt::cuda::PCG{}.solve(H, rhs, x_gpu);

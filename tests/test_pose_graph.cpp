@@ -10,6 +10,7 @@
 #include "bundletrack/solvers/dense_ldlt.hpp"
 #include "bundletrack/solvers/gauss_newton.hpp"
 #include "bundletrack/solvers/pcg.hpp"
+#include "pose_graph_system.hpp"
 
 namespace bt = bundletrack;
 
@@ -134,22 +135,9 @@ TEST_CASE("feature and dense residual Jacobians equal central differences of the
 }
 
 TEST_CASE("PCG and dense LDLT give the same update on a pose-graph system") {
-  std::mt19937 rng(4);
-  // A 12-node system with the structure of a pose graph: SPD, coupled blocks, strongly varying
-  // scales between translation and rotation.
-  const int n = 6 * 12;
-  Eigen::MatrixXd J = Eigen::MatrixXd::Zero(3 * n, n);
-  std::normal_distribution<double> normal;
-  for (int r = 0; r < J.rows(); ++r) {
-    const int a = (r / 6) % 12, b = (a + 1 + r % 5) % 12;
-    for (int c = 0; c < 6; ++c) {
-      J(r, 6 * a + c) = normal(rng) * (c < 3 ? 1.0 : 0.05);
-      J(r, 6 * b + c) = -normal(rng) * (c < 3 ? 1.0 : 0.05);
-    }
-  }
-  const Eigen::MatrixXd H = J.transpose() * J + 1e-6 * Eigen::MatrixXd::Identity(n, n);
-  Eigen::VectorXd rhs(n);
-  for (int k = 0; k < n; ++k) rhs[k] = normal(rng);
+  Eigen::MatrixXd H;
+  Eigen::VectorXd rhs;
+  poseGraphSystem(12, 4, 1e-6, H, rhs);
   Eigen::VectorXd x_pcg, x_ldlt;
   bt::PCG pcg;
   pcg.max_iterations = 500;
