@@ -27,9 +27,47 @@ struct OptimizationReport {
   int residuals = 0;  ///< in the last linearisation
 };
 
-/// Gauss-Newton on the pose graph (paper IV-D): linearise every edge, assemble the normal
-/// equations of the free nodes (all but node 0, which stays fixed as the reference), solve with
-/// the LinearSolver, update T_k <- T_k exp(d_k). A free node without residuals keeps its pose.
+/// Assembles the normal equations of the free nodes (all but node 0) at the given poses: H (6k x
+/// 6k, k = nodes - 1) and b = J^T W r. Edges linearise independently (in parallel); the scatter is
+/// serial and ordered, so the result does not depend on the thread schedule. Returns the cost and
+/// writes the number of residuals.
+template <PoseGraphEnergy EnergyT>
+double assembleNormalEquations(const EnergyT& energy, const std::vector<const Keyframe*>& nodes,
+                               const std::vector<GraphEdge>& edges, const PinholeCameraf& grid_camera,
+                               const std::vector<SE3d>& poses, Eigen::MatrixXd& H, Eigen::VectorXd& b,
+                               int& residuals) {
+  const int n = 6 * (int(nodes.size()) - 1);
+  H.setZero(n, n);
+  b.setZero(n);
+  std::vector<PairSystem> pairs(edges.size());
+  cv::parallel_for_(cv::Range(0, int(edges.size())), [&](const cv::Range& range) {
+    for (int e = range.start; e < range.end; ++e) {
+      const GraphEdge& edge = edges[std::size_t(e)];
+      energy.linearise(PairInput{*nodes[edge.i], *nodes[edge.j], poses[edge.i], poses[edge.j], *edge.matches, grid_camera},
+                       pairs[std::size_t(e)]);
+    }
+  });
+  double cost = 0.0;
+  residuals = 0;
+  for (std::size_t e = 0; e < edges.size(); ++e) {
+    const GraphEdge& edge = edges[e];
+    const PairSystem& pair = pairs[e];
+    cost += pair.cost;
+    residuals += pair.residuals;
+    const int index[2] = {edge.i - 1, edge.j - 1};  // node 0 is fixed: it has no unknowns
+    for (int a = 0; a < 2; ++a) {
+      if (index[a] < 0) continue;
+      b.segment<6>(6 * index[a]) += pair.b.segment<6>(6 * a);
+      for (int c = 0; c < 2; ++c)
+        if (index[c] >= 0) H.block<6, 6>(6 * index[a], 6 * index[c]) += pair.H.block<6, 6>(6 * a, 6 * c);
+    }
+  }
+  return cost;
+}
+
+/// Gauss-Newton on the pose graph (paper IV-D): assemble the normal equations of the free nodes
+/// (node 0 stays fixed as the reference), solve with the LinearSolver, update T_k <- T_k exp(d_k).
+/// A free node without residuals keeps its pose.
 template <PoseGraphEnergy EnergyT, LinearSolver Solver>
 OptimizationReport optimizePoseGraph(const EnergyT& energy, const Solver& solver, const std::vector<const Keyframe*>& nodes,
                                      const std::vector<GraphEdge>& edges, const PinholeCameraf& grid_camera,
@@ -37,39 +75,11 @@ OptimizationReport optimizePoseGraph(const EnergyT& energy, const Solver& solver
   OptimizationReport report;
   const int free_nodes = int(nodes.size()) - 1;
   if (free_nodes <= 0) return report;
-  const int n = 6 * free_nodes;
-  Eigen::MatrixXd H(n, n);
-  Eigen::VectorXd b(n), delta(n);
-  std::vector<PairSystem> pairs(edges.size());
+  Eigen::MatrixXd H;
+  Eigen::VectorXd b, delta;
   for (int iteration = 0; iteration < settings.iterations; ++iteration) {
-    H.setZero();
-    b.setZero();
-    double cost = 0.0;
     int residuals = 0;
-    // Edges linearise independently (in parallel); the scatter below is serial and ordered, so the
-    // result does not depend on the thread schedule.
-    cv::parallel_for_(cv::Range(0, int(edges.size())), [&](const cv::Range& range) {
-      for (int e = range.start; e < range.end; ++e) {
-        const GraphEdge& edge = edges[std::size_t(e)];
-        pairs[std::size_t(e)] = PairSystem();
-        energy.linearise(
-            PairInput{*nodes[edge.i], *nodes[edge.j], poses[edge.i], poses[edge.j], *edge.matches, grid_camera},
-            pairs[std::size_t(e)]);
-      }
-    });
-    for (std::size_t e = 0; e < edges.size(); ++e) {
-      const GraphEdge& edge = edges[e];
-      const PairSystem& pair = pairs[e];
-      cost += pair.cost;
-      residuals += pair.residuals;
-      const int index[2] = {edge.i - 1, edge.j - 1};  // node 0 is fixed: it has no unknowns
-      for (int a = 0; a < 2; ++a) {
-        if (index[a] < 0) continue;
-        b.segment<6>(6 * index[a]) += pair.b.segment<6>(6 * a);
-        for (int c = 0; c < 2; ++c)
-          if (index[c] >= 0) H.block<6, 6>(6 * index[a], 6 * index[c]) += pair.H.block<6, 6>(6 * a, 6 * c);
-      }
-    }
+    const double cost = assembleNormalEquations(energy, nodes, edges, grid_camera, poses, H, b, residuals);
     if (iteration == 0) report.initial_cost = cost;
     report.final_cost = cost;
     report.residuals = residuals;
