@@ -1,0 +1,99 @@
+// bench_tracker [--sequence DIR ...] [--frames N]
+// Runs the default tracker on each sequence (or on a synthetic one rendered in memory) and prints,
+// per stage, the median and 90th percentile of the milliseconds per frame, the share of the
+// median frame, and frames per second (tracking only, and with reading + preprocessing).
+#include <algorithm>
+#include <cstdio>
+#include <string>
+#include <vector>
+
+#include "bundletrack/io/ycbineoat_sequence.hpp"
+#include "bundletrack/synth/synthetic_sequence.hpp"
+#include "bundletrack/tracker.hpp"
+
+namespace bt = bundletrack;
+
+namespace {
+
+double percentile(std::vector<double> v, double q) {
+  if (v.empty()) return 0.0;
+  std::sort(v.begin(), v.end());
+  return v[std::min(v.size() - 1, std::size_t(q * double(v.size() - 1) + 0.5))];
+}
+
+struct Stages {
+  std::vector<double> read, mask, features, matching, ransac, graph, solve, total;
+  void add(double read_ms, const bt::StageTimings& t) {
+    read.push_back(read_ms), mask.push_back(t.mask), features.push_back(t.features), matching.push_back(t.matching);
+    ransac.push_back(t.ransac), graph.push_back(t.graph), solve.push_back(t.solve), total.push_back(t.total);
+  }
+};
+
+void report(const std::string& name, const Stages& s) {
+  const double median_total = percentile(s.total, 0.5);
+  std::printf("\n%s: %zu frames (read = loading and preprocessing, outside the tracker's total)\n%-10s %10s %10s %9s\n",
+              name.c_str(), s.total.size(), "stage", "median ms", "p90 ms", "of total");
+  const std::pair<const char*, const std::vector<double>*> rows[] = {
+      {"read", &s.read},         {"mask", &s.mask},   {"features", &s.features}, {"matching", &s.matching},
+      {"ransac", &s.ransac},     {"graph", &s.graph}, {"solve", &s.solve},       {"total", &s.total}};
+  for (const auto& [label, values] : rows)
+    std::printf("%-10s %10.2f %10.2f %7.1f%%\n", label, percentile(*values, 0.5), percentile(*values, 0.9),
+                100.0 * percentile(*values, 0.5) / median_total);
+  double sum = 0.0, sum_read = 0.0;
+  for (std::size_t i = 0; i < s.total.size(); ++i) sum += s.total[i], sum_read += s.read[i];
+  std::printf("frames per second: %.1f tracking, %.1f with reading and preprocessing\n",
+              1000.0 * double(s.total.size()) / sum, 1000.0 * double(s.total.size()) / (sum + sum_read));
+}
+
+template <typename FrameAt>
+Stages track(const bt::PinholeCameraf& camera, std::size_t frames, FrameAt&& frame_at) {
+  bt::DefaultTracker tracker(camera);
+  Stages stages;
+  for (std::size_t i = 0; i < frames; ++i) {
+    bt::Stopwatch read;
+    const auto [frame, pose] = frame_at(i);
+    const double read_ms = read.lap();
+    const bt::TrackResult result = i == 0 ? tracker.initialize(frame, pose) : tracker.track(frame);
+    if (i > 0) stages.add(read_ms, result.timings);
+  }
+  return stages;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  std::vector<std::string> sequences;
+  int frames = 150;
+  for (int i = 1; i + 1 < argc; i += 2) {
+    const std::string arg = argv[i];
+    if (arg == "--sequence") sequences.emplace_back(argv[i + 1]);
+    else if (arg == "--frames") frames = std::atoi(argv[i + 1]);
+    else {
+      std::fprintf(stderr, "usage: bench_tracker [--sequence DIR ...] [--frames N]\n");
+      return 2;
+    }
+  }
+  try {
+    if (sequences.empty()) {
+      bt::synth::SyntheticSequenceSettings settings;
+      settings.frames = frames;
+      const bt::synth::SyntheticScene scene(settings);
+      const auto camera = settings.camera.cast<float>();
+      report("synthetic hand-held box (rendering counted as reading)",
+             track(camera, std::size_t(frames), [&](std::size_t i) {
+               const auto f = scene.frame(int(i));
+               return std::pair(bt::makeFrame(std::to_string(i), f.color, f.depth, f.mask, camera), f.T_cam_obj);
+             }));
+    }
+    for (const auto& dir : sequences) {
+      const bt::io::YcbineoatSequence sequence(dir);
+      report(dir, track(sequence.camera().cast<float>(), sequence.size(), [&](std::size_t i) {
+               return std::pair(sequence.frame(i), sequence.hasGroundTruth() ? sequence.groundTruthPose(i) : bt::SE3d());
+             }));
+    }
+  } catch (const std::exception& error) {
+    std::fprintf(stderr, "error: %s\n", error.what());
+    return 1;
+  }
+  return 0;
+}
