@@ -1,12 +1,15 @@
-// Linear solvers on pose-graph normal equations taken from a tracker run: PCG (the tracker's
-// truncated 5 iterations, and to convergence) vs dense LDLT vs Eigen's ConjugateGradient, for
-// graphs of 2..64 nodes. Systems come from a synthetic hand-held box tracked with keyframes every
+// The pose graph's pieces on data from a tracker run: linear solvers on its normal equations, PCG
+// (the tracker's truncated 5 iterations, and to convergence) vs dense LDLT vs Eigen's
+// ConjugateGradient, for graphs of 2..64 nodes; residual evaluation and assembly throughput of the
+// feature and dense terms; greedy keyframe selection. Systems come from a synthetic hand-held box tracked with keyframes every
 // 2.5 degrees, so that 64 keyframes exist; edges carry matched and RANSAC-pruned features and the
 // dense term, as in the tracker.
 #include <benchmark/benchmark.h>
 
 #include <Eigen/IterativeLinearSolvers>
+#include <deque>
 #include <map>
+#include <random>
 
 #include "bundletrack/synth/synthetic_sequence.hpp"
 #include "bundletrack/tracker.hpp"
@@ -20,56 +23,119 @@ struct System {
   Eigen::VectorXd rhs;
 };
 
-/// Normal equations of the first `nodes` keyframes of one tracker run (built once, then cached).
-const System& systemOfSize(int nodes) {
-  static std::map<int, System> systems;
-  static std::vector<bt::Keyframe> keyframes;
-  static bt::PinholeCameraf camera;
-  if (keyframes.empty()) {
+/// The keyframes of one tracker run (synthetic hand-held box, keyframes every 2.5 degrees).
+struct TrackedKeyframes {
+  std::vector<bt::Keyframe> keyframes;
+  bt::PinholeCameraf camera;
+};
+
+const TrackedKeyframes& trackedKeyframes() {
+  static const TrackedKeyframes run = [] {
+    TrackedKeyframes out;
     bt::synth::SyntheticSequenceSettings settings;
     settings.frames = 300;
     settings.speed = 1.5;
     const bt::synth::SyntheticScene scene(settings);
-    camera = settings.camera.cast<float>();
+    out.camera = settings.camera.cast<float>();
     bt::TrackerSettings tracker_settings;
     tracker_settings.new_keyframe_rotation_deg = 2.5;
-    bt::DefaultTracker tracker(camera, tracker_settings);
+    bt::DefaultTracker tracker(out.camera, tracker_settings);
     for (int i = 0; i < settings.frames; ++i) {
       const auto f = scene.frame(i);
-      const bt::RgbdFrame frame = bt::makeFrame(std::to_string(i), f.color, f.depth, f.mask, camera);
+      const bt::RgbdFrame frame = bt::makeFrame(std::to_string(i), f.color, f.depth, f.mask, out.camera);
       if (i == 0) tracker.initialize(frame, f.T_cam_obj);
       else tracker.track(frame);
     }
-    for (std::size_t k = 0; k < tracker.keyframes().size(); ++k) keyframes.push_back(tracker.keyframes()[k]);
-  }
-  if (auto found = systems.find(nodes); found != systems.end()) return found->second;
-  const int count = std::min<int>(nodes, int(keyframes.size()));
-  std::vector<const bt::Keyframe*> graph;
+    for (std::size_t k = 0; k < tracker.keyframes().size(); ++k) out.keyframes.push_back(tracker.keyframes()[k]);
+    return out;
+  }();
+  return run;
+}
+
+/// The pose graph over the first `nodes` keyframes: all pairs, features matched with the pose gate
+/// and pruned by RANSAC, as the tracker builds it.
+struct Graph {
+  std::vector<const bt::Keyframe*> nodes;
   std::vector<bt::SE3d> poses;
-  for (int k = 0; k < count; ++k) graph.push_back(&keyframes[std::size_t(k)]), poses.push_back(keyframes[std::size_t(k)].T_cam_obj);
+  std::deque<std::vector<bt::FeatureMatch>> matches;
+  std::vector<bt::GraphEdge> edges;
+};
+
+const Graph& graphOfSize(int size) {
+  static std::map<int, Graph> graphs;
+  if (auto found = graphs.find(size); found != graphs.end()) return found->second;
+  const TrackedKeyframes& run = trackedKeyframes();
+  Graph& graph = graphs[size];
+  const int count = std::min<int>(size, int(run.keyframes.size()));
+  for (int k = 0; k < count; ++k)
+    graph.nodes.push_back(&run.keyframes[std::size_t(k)]), graph.poses.push_back(run.keyframes[std::size_t(k)].T_cam_obj);
   const bt::SiftFeatures sift;
   const bt::Ransac ransac;
-  std::vector<std::vector<bt::FeatureMatch>> matches;
-  matches.reserve(std::size_t(count * count));
-  std::vector<bt::GraphEdge> edges;
   for (int a = 0; a < count; ++a) {
     for (int b = a + 1; b < count; ++b) {
-      const bt::MatchGate gate{(poses[b] * poses[a].inverse()).cast<float>()};
-      const auto m = sift.match(graph[a]->features, graph[b]->features, gate);
-      const auto pruned = ransac.estimate(graph[a]->features, graph[b]->features, m);
-      matches.emplace_back();
-      for (const int k : pruned.inliers) matches.back().push_back(m[std::size_t(k)]);
-      edges.push_back({a, b, &matches.back()});
+      const bt::MatchGate gate{(graph.poses[b] * graph.poses[a].inverse()).cast<float>()};
+      const auto m = sift.match(graph.nodes[a]->features, graph.nodes[b]->features, gate);
+      const auto pruned = ransac.estimate(graph.nodes[a]->features, graph.nodes[b]->features, m);
+      graph.matches.emplace_back();
+      for (const int k : pruned.inliers) graph.matches.back().push_back(m[std::size_t(k)]);
+      graph.edges.push_back({a, b, &graph.matches.back()});
     }
   }
+  return graph;
+}
+
+/// Normal equations of the first `nodes` keyframes (built once, then cached).
+const System& systemOfSize(int nodes) {
+  static std::map<int, System> systems;
+  if (auto found = systems.find(nodes); found != systems.end()) return found->second;
+  const Graph& graph = graphOfSize(nodes);
   System system;
   Eigen::VectorXd b;
   int residuals = 0;
-  bt::assembleNormalEquations(bt::DefaultEnergy{}, graph, edges, bt::downsampledCamera(camera, 4), poses, system.H, b,
-                              residuals);
+  bt::assembleNormalEquations(bt::DefaultEnergy{}, graph.nodes, graph.edges,
+                              bt::downsampledCamera(trackedKeyframes().camera, 4), graph.poses, system.H, b, residuals);
   system.rhs = -b;
   if (system.rhs.norm() == 0.0) system.rhs.setOnes();  // at the optimum b = 0: solve for a unit load instead
   return systems.emplace(nodes, std::move(system)).first->second;
+}
+
+/// Residual evaluation and normal-equation assembly of one energy term over a whole graph.
+template <typename EnergyT>
+void assemble(benchmark::State& state) {
+  const Graph& graph = graphOfSize(int(state.range(0)));
+  const bt::PinholeCameraf grid = bt::downsampledCamera(trackedKeyframes().camera, 4);
+  Eigen::MatrixXd H;
+  Eigen::VectorXd b;
+  int residuals = 0;
+  for (auto _ : state) {
+    bt::assembleNormalEquations(EnergyT{}, graph.nodes, graph.edges, grid, graph.poses, H, b, residuals);
+    benchmark::DoNotOptimize(H.data());
+  }
+  state.counters["residuals"] = residuals;
+  state.counters["residuals_per_second"] = benchmark::Counter(double(residuals), benchmark::Counter::kIsIterationInvariantRate);
+}
+
+void BM_AssembleFeatureTerm(benchmark::State& state) {
+  assemble<bt::Energy<bt::Term<bt::FeaturePointToPoint, bt::HuberLoss>>>(state);
+}
+
+void BM_AssembleDenseTerm(benchmark::State& state) {
+  assemble<bt::Energy<bt::Term<bt::DensePointToPlane, bt::HuberLoss>>>(state);
+}
+
+/// Greedy selection of 15 keyframes (paper IV-C) from pools of growing size.
+void BM_SelectKeyframes(benchmark::State& state) {
+  bt::KeyframePool pool(std::size_t(state.range(0)));
+  std::mt19937 rng(1);
+  std::normal_distribution<double> normal;
+  for (int k = 0; k < state.range(0); ++k) {
+    bt::Keyframe keyframe;
+    keyframe.id = k;
+    keyframe.T_cam_obj = bt::SE3d(bt::SO3d::exp(Eigen::Vector3d(normal(rng), normal(rng), normal(rng))), {0, 0, 0});
+    pool.add(std::move(keyframe));
+  }
+  const bt::SO3d current = bt::SO3d::exp(Eigen::Vector3d(0.1, 0.2, 0.3));
+  for (auto _ : state) benchmark::DoNotOptimize(pool.select(current, 15));
 }
 
 template <typename Solve>
@@ -114,4 +180,7 @@ BENCHMARK(BM_PCG5)->RangeMultiplier(2)->Range(2, 64)->Unit(benchmark::kMicroseco
 BENCHMARK(BM_PCGConverged)->RangeMultiplier(2)->Range(2, 64)->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_DenseLDLT)->RangeMultiplier(2)->Range(2, 64)->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_EigenConjugateGradient)->RangeMultiplier(2)->Range(2, 64)->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_AssembleFeatureTerm)->RangeMultiplier(2)->Range(2, 64)->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_AssembleDenseTerm)->RangeMultiplier(2)->Range(2, 64)->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_SelectKeyframes)->RangeMultiplier(4)->Range(16, 1024)->Unit(benchmark::kMicrosecond);
 BENCHMARK_MAIN();

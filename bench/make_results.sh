@@ -4,7 +4,10 @@
 set -euo pipefail
 build=${1:-build}
 out=$(dirname "$0")/RESULTS.md
-solvers=$("$build/bin/bench_solvers" --benchmark_format=csv 2>/dev/null)
+# One run per group: Google Benchmark's CSV needs the same counters in every row.
+solvers=$("$build/bin/bench_solvers" --benchmark_format=csv --benchmark_filter='PCG|LDLT|Eigen' 2>/dev/null)
+assembly=$("$build/bin/bench_solvers" --benchmark_format=csv --benchmark_filter='Assemble' 2>/dev/null)
+selection=$("$build/bin/bench_solvers" --benchmark_format=csv --benchmark_filter='SelectKeyframes' 2>/dev/null)
 depth=$("$build/bin/bench_depth_processing" --benchmark_format=csv 2>/dev/null)
 {
   echo "# Benchmark results"
@@ -33,6 +36,31 @@ depth=$("$build/bin/bench_depth_processing" --benchmark_format=csv 2>/dev/null)
                r["BM_EigenConjugateGradient", n]
       }
     }'
+  echo
+  echo "## Residual evaluation and normal-equation assembly (bench_solvers)"
+  echo
+  echo "All edges of the same graphs, one term each (a feature residual is one 3-vector). Throughput"
+  echo "relative to the dense term's at 16 nodes in this run."
+  echo
+  echo "| nodes | feature residuals | feature throughput | dense residuals | dense throughput |"
+  echo "|---|---|---|---|---|"
+  echo "$assembly" | awk -F, '
+    !/^"BM_/ { if (/^name,/) for (i = 1; i <= NF; i++) { h = $i; gsub(/"/, "", h); col[h] = i }; next }
+    /BM_Assemble/ { split($1, p, "/"); name = p[1]; gsub(/"/, "", name); n = p[2] + 0
+      count[name, n] = $(col["residuals"]); rate[name, n] = $(col["residuals_per_second"]); seen[n] = 1 }
+    END {
+      ref = rate["BM_AssembleDenseTerm", 16]
+      for (n = 2; n <= 64; n *= 2) if (seen[n])
+        printf "| %d | %d | %.2f | %d | %.2f |\n", n, count["BM_AssembleFeatureTerm", n], rate["BM_AssembleFeatureTerm", n] / ref,
+               count["BM_AssembleDenseTerm", n], rate["BM_AssembleDenseTerm", n] / ref
+    }'
+  echo
+  echo "## Greedy keyframe selection of 15 (bench_solvers)"
+  echo
+  echo "| pool size | time relative to a pool of 16 |"
+  echo "|---|---|"
+  echo "$selection" | awk -F, '/BM_SelectKeyframes/ { split($1, p, "/"); n = p[2] + 0; t[n] = $3; order[++k] = n }
+    END { for (i = 1; i <= k; i++) printf "| %d | %.1f |\n", order[i], t[order[i]] / t[16] }'
   echo
   echo "## Depth preprocessing, 640x480 (bench_depth_processing)"
   echo
