@@ -94,6 +94,7 @@ class Tracker {
     TrackResult result;
     const int id = ++frame_index_;
     RgbdFrame masked = withMask(frame, result.timings, watch);
+    if (cv::countNonZero(masked.mask) == 0) return lost(result, total);  // the object is out of sight
     FrameFeatures features = correspondences_.detect(masked);
     result.timings.features = watch.lap();
     result.keypoints = int(features.size());
@@ -105,7 +106,6 @@ class Tracker {
     result.timings.ransac += watch.lap();
     result.matches = int(matches.size());
     result.inliers = int(coarse.inliers.size());
-    if (cv::countNonZero(masked.mask) == 0) return lost(result, total);  // the object is out of sight
     const bool coarse_ok = result.inliers >= settings_.coarse.min_inliers;
     const SE3d T_coarse = coarse_ok ? coarse.T_second_first * previous_->T_cam_obj : previous_->T_cam_obj;
 
