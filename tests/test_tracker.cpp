@@ -73,3 +73,31 @@ TEST_CASE("feature-only and dense-only energies compose and track; dense alone h
   const Run features = track(FeatureOnly(box.camera.cast<float>()), box_scene, box_scene.objectMesh().sampleSurface(1000, 1));
   CHECK(features.score.adds_auc >= 95.0);
 }
+
+TEST_CASE("object out of view for 30 frames: reported lost while gone, recovered on return, no wrong pose") {
+  synth::SyntheticSequenceSettings settings;
+  settings.frames = 100;
+  settings.speed = 2.0;
+  settings.hidden_start = 60;  // carried out of view near the turning point of the motion ...
+  settings.hidden_frames = 30;  // ... and back at frame 90, 30 degrees from where it left
+  const synth::SyntheticScene scene(settings);
+  const auto camera = settings.camera.cast<float>();
+  bt::DefaultTracker tracker(camera);
+  int lost_while_gone = 0, first_recovered = -1, wrong = 0;
+  for (int i = 0; i < settings.frames; ++i) {
+    const synth::SyntheticFrame f = scene.frame(i);
+    const bt::RgbdFrame frame = bt::makeFrame(std::to_string(i), f.color, f.depth, f.mask, camera);
+    const bt::TrackResult r = i == 0 ? tracker.initialize(frame, f.T_cam_obj) : tracker.track(frame);
+    const bool gone = i >= settings.hidden_start && i < settings.hidden_start + settings.hidden_frames;
+    if (gone) lost_while_gone += r.status == bt::TrackStatus::Lost;
+    if (r.status == bt::TrackStatus::Lost) continue;
+    // Any pose the tracker stands behind must be right (5 deg, 1 cm), before and after the gap.
+    wrong += bt::rotationErrorDeg(f.T_cam_obj, r.T_cam_obj) > 5.0 || bt::translationError(f.T_cam_obj, r.T_cam_obj) > 0.01;
+    if (!gone && i >= settings.hidden_start && first_recovered < 0) first_recovered = i;
+  }
+  MESSAGE("lost while gone: " << lost_while_gone << " of 30, first good frame after return: " << first_recovered);
+  CHECK(lost_while_gone == settings.hidden_frames);
+  REQUIRE(first_recovered >= 0);
+  CHECK(first_recovered - (settings.hidden_start + settings.hidden_frames) < 10);
+  CHECK(wrong == 0);
+}

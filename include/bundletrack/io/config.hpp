@@ -78,6 +78,7 @@ inline std::vector<ConfigParameter> configParameters(Config& c) {
       {"graph", "min_edge_correspondences", &t.min_edge_correspondences, 3, 100000, "", "fewer: the edge has no feature term"},
       {"graph", "min_agreement", &t.min_agreement, 0.0, 1.0, "", "fraction of overlapping points on a keyframe's surface to accept the graph's pose"},
       {"graph", "agreement_distance", &t.agreement_distance, 0.0, 1.0, "m", "on the surface: within this distance"},
+      {"graph", "recovery_min_inliers", &t.recovery_min_inliers, 3, 100000, "", "RANSAC inliers needed to restart after lost frames"},
       {"graph", "gauss_newton_iterations", &t.gauss_newton.iterations, 0, 1000, "", "paper IV-D, original code: 7"},
   };
 }

@@ -32,6 +32,8 @@ struct SyntheticSequenceSettings {
   Motion motion = Motion::HandHeld;
   double speed = 1.0;  ///< scales the motion's phase rate (see HandHeldMotion)
   bool occluder = false;  ///< an arm passes between camera and object around the middle frame
+  int hidden_start = -1;  ///< from this frame the hand carries the object out of view (-1: never) ...
+  int hidden_frames = 0;  ///< ... for this many frames; it comes back where its motion has taken it
   int motion_blur_samples = 1;  ///< > 1: colour averaged over this many instants of a half-frame exposure
   SensorSettings sensor;
   unsigned seed = 1;
@@ -69,7 +71,12 @@ class SyntheticScene {
   const TriangleMesh& objectMesh() const { return object_mesh_; }
 
   SE3d T_world_obj(double frame) const {
-    if (s_.motion == Motion::HandHeld) return HandHeldMotion().T_world_obj(frame, s_.speed);
+    if (s_.motion == Motion::HandHeld) {
+      SE3d T = HandHeldMotion().T_world_obj(frame, s_.speed);
+      if (frame >= s_.hidden_start && frame < s_.hidden_start + s_.hidden_frames)
+        T = SE3d(T.rotation(), T.translation() + Eigen::Vector3d(2.0, 0.0, 0.0));  // far outside the view
+      return T;
+    }
     return SE3d(SO3d(), Eigen::Vector3d(0.0, 0.0, restingHeight()));
   }
 
