@@ -4,6 +4,10 @@
 set -euo pipefail
 build=${1:-build}
 out=$(dirname "$0")/RESULTS.md
+# awk prologue shared by the tables: maps Google Benchmark's CSV header (counters are quoted) to
+# column numbers in col[], and skips every line that is not a benchmark row.
+columns='!/^"BM_/ { if (/^name,/) for (i = 1; i <= NF; i++) { h = $i; gsub(/"/, "", h); col[h] = i }; next }
+'
 # One run per group: Google Benchmark's CSV needs the same counters in every row.
 solvers=$("$build/bin/bench_solvers" --benchmark_format=csv --benchmark_filter='PCG|LDLT|Eigen' 2>/dev/null)
 assembly=$("$build/bin/bench_solvers" --benchmark_format=csv --benchmark_filter='Assemble' 2>/dev/null)
@@ -24,8 +28,7 @@ depth=$("$build/bin/bench_depth_processing" --benchmark_format=csv 2>/dev/null)
   echo
   echo "| nodes | unknowns | PCG 5 it. (tracker default) | residual | PCG converged | residual | Eigen CG | residual | LDLT |"
   echo "|---|---|---|---|---|---|---|---|---|"
-  echo "$solvers" | awk -F, '
-    !/^"BM_/ { if (/^name,/) for (i = 1; i <= NF; i++) { h = $i; gsub(/"/, "", h); col[h] = i }; next }
+  echo "$solvers" | awk -F, "$columns"'
     { split($1, p, "/"); name = p[1]; gsub(/"/, "", name); n = p[2] + 0; gsub(/"/, "", n)
       t[name, n] = $3; r[name, n] = $(col["rel_residual"]); u[n] = $(col["unknowns"]); seen[n] = 1 }
     END {
@@ -44,8 +47,7 @@ depth=$("$build/bin/bench_depth_processing" --benchmark_format=csv 2>/dev/null)
   echo
   echo "| nodes | feature residuals | feature throughput | dense residuals | dense throughput |"
   echo "|---|---|---|---|---|"
-  echo "$assembly" | awk -F, '
-    !/^"BM_/ { if (/^name,/) for (i = 1; i <= NF; i++) { h = $i; gsub(/"/, "", h); col[h] = i }; next }
+  echo "$assembly" | awk -F, "$columns"'
     /BM_Assemble/ { split($1, p, "/"); name = p[1]; gsub(/"/, "", name); n = p[2] + 0
       count[name, n] = $(col["residuals"]); rate[name, n] = $(col["residuals_per_second"]); seen[n] = 1 }
     END {

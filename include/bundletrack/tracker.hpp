@@ -127,7 +127,7 @@ class Tracker {
     }
 
     // Pose graph over the selected keyframes and the current frame (paper IV-C, IV-D).
-    const Keyframe current =
+    Keyframe current =
         makeKeyframe(id, masked, masked.mask, std::move(features), T_coarse, settings_.dense_grid_step);
     // Ascending ids put frame 0 first (the fixed node) and give every keyframe pair one orientation.
     std::vector<std::size_t> selected = pool_.select(T_coarse.rotation(), settings_.max_keyframes);
@@ -173,14 +173,14 @@ class Tracker {
     }
     result.timings.solve = watch.lap();
 
-    // Paper IV-E: keep the frame when it shows a novel view.
-    Keyframe kept = current;
-    kept.T_cam_obj = result.T_cam_obj;
+    // Paper IV-E: keep the frame when it shows a novel view (a copy only then: the graph is done,
+    // and the features move on to the next frame's coarse step).
+    current.T_cam_obj = result.T_cam_obj;
     if (result.status == TrackStatus::Tracked &&
         pool_.isNovelView(result.T_cam_obj.rotation(), settings_.new_keyframe_rotation_deg * std::numbers::pi / 180.0)) {
-      if (const int evicted = pool_.add(std::move(kept)); evicted >= 0) forget(evicted);
+      if (const int evicted = pool_.add(current); evicted >= 0) forget(evicted);
     }
-    previous_ = Previous{id, result.T_cam_obj, current.features};
+    previous_ = Previous{id, result.T_cam_obj, std::move(current.features)};
     lost_streak_ = 0;
     result.timings.graph += watch.lap();
     result.timings.total = total.lap();
