@@ -18,6 +18,8 @@ const char* const kUsage = R"(usage: bundletrack_synth --out DIR [options]
   --motion M         handheld (static camera, object turned up to 180 deg) | orbit (camera orbits) (handheld)
   --speed X          motion speed scale; 1 turns the object by at most 1.9 deg per frame (1)
   --occluder         an arm passes in front of the object around the middle frame
+  --out-of-view S N  from frame S the object is carried out of view for N frames, then comes back
+                     where its motion has taken it (its masks are empty meanwhile)
   --motion-blur N    average the colour over N instants of the exposure (1 = off)
   --no-noise         perfect sensor: no depth noise, quantisation, dropouts or colour noise
   --seed N           random seed of textures and sensor noise (1)
@@ -70,6 +72,11 @@ int main(int argc, char** argv) {
       settings.speed = number(arg, value());
     } else if (arg == "--occluder") {
       settings.occluder = true;
+    } else if (arg == "--out-of-view") {
+      settings.hidden_start = int(number(arg, value()));
+      settings.hidden_frames = int(number(arg, value()));
+      if (settings.hidden_start < 1 || settings.hidden_frames < 1)
+        fail("--out-of-view needs a start frame >= 1 and a frame count >= 1");
     } else if (arg == "--motion-blur") {
       settings.motion_blur_samples = int(number(arg, value()));
     } else if (arg == "--no-noise") {

@@ -1,7 +1,9 @@
 // bundletrack_track --sequence DIR --out DIR [options]
-// Tracks the object of a YCBInEOAT-layout sequence from its first mask and pose; writes
-// OUT/poses/<frame>.txt (4x4 T_cam_obj) and OUT/track.csv, and prints the accuracy when the
-// sequence has ground truth and a model.
+// Tracks the object of a YCBInEOAT-layout sequence from its first pose and its masks (every
+// frame's, or with --propagate-masks the first one only); writes OUT/poses/<frame>.txt (4x4
+// T_cam_obj) and OUT/track.csv, and prints the accuracy when the sequence has ground truth and a
+// model, and the propagated masks' IoU when it has masks.
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -10,6 +12,7 @@
 
 #include <unistd.h>
 
+#include "bundletrack/eval/mask_iou.hpp"
 #include "bundletrack/eval/score_table.hpp"
 #include "bundletrack/io/config.hpp"
 #include "bundletrack/viz/overlay.hpp"
@@ -30,6 +33,10 @@ const char* const kUsage = R"(usage: bundletrack_track --sequence DIR --out DIR 
   --depth-scale S    metres per unit of the depth images (0.001)
   --min-inliers N    fewest RANSAC inliers that count as a pose; fewer: the frame is lost (5)
   --inlier-mm D      RANSAC inlier distance in millimetres (5)
+  --propagate-masks  the tracker gets only the first frame's mask and follows the object from it
+                     (masks.source: propagated); later masks, where the sequence has them, are
+                     read only to report each propagated mask's IoU in track.csv and a summary;
+                     the masks used go to OUT/masks/<frame>.png
   --viz              write OUT/overlay.mp4 (pose axes, object box, mask outline per frame; an image
                      strip OUT/overlay_strip.png always, and in place of the video where no encoder
                      is available) and, with ground truth, OUT/errors.png (errors over time)
@@ -110,21 +117,26 @@ class OverlayWriter {
 template <typename Tracker>
 int run(Tracker tracker, const bt::io::YcbineoatSequence& sequence, const Options& options) {
   fs::create_directories(options.out / "poses");
+  if (options.config.masks == "propagated") fs::create_directories(options.out / "masks");
   std::ofstream csv(options.out / "track.csv");
   const bool scored = sequence.hasGroundTruth() && sequence.hasModel();
+  const bool propagated = options.config.masks == "propagated";
   csv << "frame,status,keypoints,matches,inliers,mask_ms,features_ms,matching_ms,ransac_ms,graph_ms,solve_ms,total_ms"
-      << (scored ? ",rotation_error_deg,translation_error_cm\n" : "\n");
+      << (scored ? ",rotation_error_deg,translation_error_cm" : "") << (propagated ? ",mask_iou\n" : "\n");
   std::vector<bt::SE3d> truth, estimate;
   int lost = 0;
   const bool interactive = isatty(fileno(stderr));
   std::optional<OverlayWriter> overlay;
   if (options.viz) overlay.emplace(options.out, sequence);
-  std::vector<double> rotation_errors, translation_errors;
+  std::vector<double> rotation_errors, translation_errors, mask_ious;
   for (std::size_t i = 0; i < sequence.size(); ++i) {
-    const bt::RgbdFrame frame = sequence.frame(i);
-    if (i > 0 && frame.mask.empty())
+    bt::RgbdFrame frame = sequence.frame(i);
+    const cv::Mat dataset_mask = frame.mask;
+    if (propagated && i > 0) frame.mask = cv::Mat();  // the tracker must not see it
+    if (!propagated && i > 0 && frame.mask.empty())
       throw bt::InputError(options.sequence / "masks" / (frame.name + ".png"),
-                           "file not found: tracking with given masks needs a mask for every frame");
+                           "file not found: tracking with given masks needs a mask for every frame "
+                           "(or use --propagate-masks)");
     const bt::SE3d initial = sequence.hasGroundTruth() ? sequence.groundTruthPose(0) : bt::SE3d();
     const bt::TrackResult result = i == 0 ? tracker.initialize(frame, initial) : tracker.track(frame);
     lost += result.status == bt::TrackStatus::Lost;
@@ -140,6 +152,16 @@ int run(Tracker tracker, const bt::io::YcbineoatSequence& sequence, const Option
       translation_errors.push_back(100.0 * bt::translationError(truth.back(), estimate.back()));
       csv << ',' << rotation_errors.back() << ',' << translation_errors.back();
     }
+    if (propagated) {
+      // A frame lost before a mask was made counts as an empty mask.
+      const cv::Mat used = result.mask.empty() ? cv::Mat::zeros(frame.depth.size(), CV_8UC1) : result.mask;
+      const fs::path mask_path = options.out / "masks" / (frame.name + ".png");
+      if (!cv::imwrite(mask_path.string(), used)) throw bt::InputError(mask_path, "cannot write image");
+      if (!dataset_mask.empty()) mask_ious.push_back(bt::maskIoU(used > 0, dataset_mask > 0));
+      csv << ',';
+      if (!dataset_mask.empty()) csv << mask_ious.back();
+    }
+    frame.mask = result.mask;  // the overlay outlines the mask the tracker used
     if (overlay) overlay->add(i, frame, result);
     csv << '\n';
     // On a terminal one line updated in place; in a log a line every 50 frames.
@@ -151,6 +173,12 @@ int run(Tracker tracker, const bt::io::YcbineoatSequence& sequence, const Option
   if (!options.quiet && interactive) std::fprintf(stderr, "\n");
   std::printf("%s: %zu frames, %d lost; poses in %s\n", options.sequence.string().c_str(), sequence.size(), lost,
               (options.out / "poses").string().c_str());
+  if (!mask_ious.empty()) {
+    double sum = 0.0;
+    for (const double iou : mask_ious) sum += iou;
+    std::printf("propagated mask IoU against the sequence's masks: mean %.3f, min %.3f over %zu frames\n",
+                sum / double(mask_ious.size()), *std::min_element(mask_ious.begin(), mask_ious.end()), mask_ious.size());
+  }
   if (scored) {
     const bt::SequenceScore score = bt::scoreSequence(sequence.modelPoints(), truth, estimate);
     std::printf("%s", bt::formatScoreTable({{options.sequence.filename().string(), score}}).c_str());
@@ -173,8 +201,14 @@ int runWith(const Options& options, const typename Source::Settings& source_sett
   const bt::io::YcbineoatSequence sequence(options.sequence, options.config.sequence);
   const bt::TrackerSettings& settings = options.config.tracker;
   if (options.tracker == "coarse") return run(bt::CoarseTracker<Source>(Source(source_settings), settings.coarse), sequence, options);
+  const bt::PinholeCameraf camera = sequence.camera().cast<float>();
+  if (options.config.masks == "propagated") {
+    using Tracker = bt::Tracker<bt::DefaultEnergy, bt::PCG, Source, bt::PropagatedMasks>;
+    return run(Tracker(camera, settings, {}, {}, Source(source_settings), bt::PropagatedMasks(options.config.propagated_masks)),
+               sequence, options);
+  }
   using Tracker = bt::Tracker<bt::DefaultEnergy, bt::PCG, Source>;
-  return run(Tracker(sequence.camera().cast<float>(), settings, {}, {}, Source(source_settings)), sequence, options);
+  return run(Tracker(camera, settings, {}, {}, Source(source_settings)), sequence, options);
 }
 
 }  // namespace
@@ -196,6 +230,7 @@ int main(int argc, char** argv) {
     else if (arg == "--print-config") print_config = true;
     else if (arg == "--features" || arg == "--depth-scale" || arg == "--min-inliers" || arg == "--inlier-mm")
       overrides.emplace_back(arg, value());
+    else if (arg == "--propagate-masks") overrides.emplace_back(arg, "");
     else if (arg == "--quiet") options.quiet = true;
     else if (arg == "--viz") options.viz = true;
     else if (arg == "--help" || arg == "-h") {
@@ -211,6 +246,7 @@ int main(int argc, char** argv) {
       else if (option == "--depth-scale") config.sequence.depth_scale = number(option, text);
       else if (option == "--min-inliers") config.tracker.coarse.min_inliers = int(number(option, text));
       else if (option == "--inlier-mm") config.tracker.coarse.ransac.inlier_distance = float(number(option, text) * 1e-3);
+      else if (option == "--propagate-masks") config.masks = "propagated";
     }
     if (print_config) {
       std::cout << bt::io::printConfig(config);
@@ -218,6 +254,8 @@ int main(int argc, char** argv) {
     }
     if (options.sequence.empty() || options.out.empty()) fail("--sequence and --out are required");
     if (options.tracker != "coarse" && options.tracker != "full") fail("unknown tracker '" + options.tracker + "'");
+    if (options.tracker == "coarse" && config.masks == "propagated")
+      fail("propagated masks need the full tracker (they render its keyframes)");
     if (config.features == "sift") return runWith<bt::SiftFeatures>(options, config.sift);
     if (config.features == "orb") return runWith<bt::OrbFeatures>(options, config.orb);
     if (config.features == "akaze") return runWith<bt::AkazeFeatures>(options, config.akaze);

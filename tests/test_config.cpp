@@ -24,7 +24,8 @@ TEST_CASE("configuration values land in the settings they name; printing reads b
                               "graph:\n  max_keyframes: 7\n  edge_gate_distance: 0.03\n"
                               "depth:\n  scale: 0.0001\n  max_depth: 2.5\n"
                               "features:\n  type: orb\n  max_keypoints: 300\n"
-                              "ransac:\n  inlier_distance: 0.01\n");
+                              "ransac:\n  inlier_distance: 0.01\n"
+                              "masks:\n  source: propagated\n  growth_px: 12\n");
   const bt::io::Config config = bt::io::loadConfig(path);
   CHECK(config.tracker.max_keyframes == 7);
   CHECK(config.tracker.edge_gate_distance == doctest::Approx(0.03f));
@@ -33,6 +34,8 @@ TEST_CASE("configuration values land in the settings they name; printing reads b
   CHECK(config.features == "orb");
   CHECK(config.orb.max_keypoints == 300);  // the detector-independent settings follow the chosen detector
   CHECK(config.tracker.coarse.ransac.inlier_distance == doctest::Approx(0.01f));
+  CHECK(config.masks == "propagated");
+  CHECK(config.propagated_masks.growth_px == 12);
   CHECK(config.tracker.new_keyframe_rotation_deg == 10.0);  // untouched keys keep their defaults
   const std::string printed = bt::io::printConfig(config);
   const bt::io::Config again = bt::io::loadConfig(writeFile(dir, "b.yaml", printed));
@@ -60,7 +63,8 @@ TEST_CASE("bad configuration files name the file and the key") {
   expect("depth:\n  scale: -1\n", "depth.scale = -1 is out of range");
   expect("ransac:\n  max_trials: 2.5\n", "must be a whole number");
   expect("ransac:\n  max_trials: many\n", "must be a number");
-  expect("features:\n  type: surf\n", "expected sift, orb or akaze");
+  expect("features:\n  type: surf\n", "expected sift | orb | akaze");
+  expect("masks:\n  source: network\n", "masks.source = 'network': expected given | propagated");
   expect("graph: [1, 2\n", "not valid YAML");
   expect("graph: 3\n", "must be a section");
   try {

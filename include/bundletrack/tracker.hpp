@@ -13,6 +13,7 @@
 #include "bundletrack/features/opencv_features.hpp"
 #include "bundletrack/graph/keyframe_pool.hpp"
 #include "bundletrack/masks/given_masks.hpp"
+#include "bundletrack/masks/propagated_masks.hpp"
 #include "bundletrack/registration/ransac.hpp"
 #include "bundletrack/residuals/dense_point_to_plane.hpp"
 #include "bundletrack/residuals/feature_point_to_point.hpp"
@@ -55,7 +56,8 @@ using DefaultEnergy = Energy<Term<FeaturePointToPoint, HuberLoss>, Term<DensePoi
 /// BundleTrack (paper IV) composed at compile time from its policies: the pose-graph energy, the
 /// linear solver of the Gauss-Newton steps, the correspondence source and the mask source.
 /// Feed frames in order: initialize() with the first, then track() each one; every call returns
-/// the pose of that frame, its status and per-stage timings, and never changes an earlier answer.
+/// the pose of that frame, its status, the mask used and per-stage timings, and never changes an
+/// earlier answer. With a PropagatedMaskSource only the first frame's mask is read.
 template <PoseGraphEnergy EnergyT = DefaultEnergy, LinearSolver Solver = PCG,
           CorrespondenceSource Correspondences = SiftFeatures, MaskSource Masks = GivenMasks>
 class Tracker {
@@ -69,14 +71,23 @@ class Tracker {
         correspondences_(std::move(correspondences)), masks_(std::move(masks)), ransac_(settings.coarse.ransac),
         pool_(settings.pool_capacity) {}
 
+  static constexpr bool kPropagatedMasks = PropagatedMaskSource<Masks>;
+
   const KeyframePool& keyframes() const { return pool_; }
 
   TrackResult initialize(const RgbdFrame& frame, const SE3d& T_cam_obj = {}) {
     Stopwatch watch, total;
     TrackResult result;
-    RgbdFrame masked = withMask(frame, result.timings, watch);
-    if (cv::countNonZero(masked.mask) == 0)
-      throw InputError("frame " + frame.name, "the first frame needs a non-empty object mask");
+    RgbdFrame masked = frame;  // shares the image buffers
+    if constexpr (kPropagatedMasks) {
+      masks_.start(frame, camera_, T_cam_obj, settings_.dense_grid_step);
+    } else {
+      masked.mask = masks_.mask(frame);
+      if (cv::countNonZero(masked.mask) == 0)
+        throw InputError("frame " + frame.name, "the first frame needs a non-empty object mask");
+    }
+    result.mask = masked.mask;
+    result.timings.mask = watch.lap();
     FrameFeatures features = correspondences_.detect(masked);
     result.timings.features = watch.lap();
     pool_ = KeyframePool(settings_.pool_capacity);
@@ -85,7 +96,7 @@ class Tracker {
     lost_streak_ = 0;
     pool_.add(makeKeyframe(0, masked, masked.mask, features, T_cam_obj, settings_.dense_grid_step));
     result.timings.graph = watch.lap();
-    previous_ = Previous{0, T_cam_obj, std::move(features)};
+    previous_ = Previous{0, T_cam_obj, std::move(features), pool_[0].points};
     result.T_cam_obj = T_cam_obj;
     result.status = TrackStatus::Tracked;
     result.keypoints = int(previous_->features.size());
@@ -98,7 +109,16 @@ class Tracker {
     Stopwatch watch, total;
     TrackResult result;
     const int id = ++frame_index_;
-    RgbdFrame masked = withMask(frame, result.timings, watch);
+    const bool recovering = lost_streak_ > 0;
+    RgbdFrame masked = frame;  // shares the image buffers
+    // Propagated masks: keypoints are searched around the object at its last pose, or everywhere
+    // after it was lost; the mask itself follows from the coarse pose below.
+    if constexpr (kPropagatedMasks)
+      masked.mask = masks_.searchRegion(frame, observedObject(previous_->T_cam_obj),
+                                        recovering ? std::nullopt : std::optional(previous_->T_cam_obj));
+    else
+      masked.mask = result.mask = masks_.mask(frame);
+    result.timings.mask = watch.lap();
     if (cv::countNonZero(masked.mask) == 0) return lost(result, total);  // the object is out of sight
     FrameFeatures features = correspondences_.detect(masked);
     result.timings.features = watch.lap();
@@ -115,15 +135,23 @@ class Tracker {
     // accepts symmetric wrong poses (a box turned by 90 degrees), and a few inliers happen by
     // chance; so the track restarts only from a feature match with recovery_min_inliers inliers,
     // with the previous good frame or else with a keyframe, that the graph then confirms.
-    const bool recovering = lost_streak_ > 0;
     const int needed = recovering ? settings_.recovery_min_inliers : settings_.coarse.min_inliers;
-    bool coarse_ok = result.inliers >= needed;
+    const bool previous_ok = result.inliers >= needed;
+    bool coarse_ok = previous_ok;
     SE3d T_coarse = coarse_ok ? coarse.T_second_first * previous_->T_cam_obj : previous_->T_cam_obj;
     if (recovering && !coarse_ok) {
       const auto recovered = matchKeyframes(features, result.timings, watch);
       if (!recovered) return lost(result, total);
       T_coarse = *recovered;
       coarse_ok = true;
+    }
+    std::vector<FeatureMatch> previous_inliers = previous_ok ? inlierMatches(matches, coarse.inliers) : std::vector<FeatureMatch>();
+    if constexpr (kPropagatedMasks) {
+      masked.mask = result.mask = masks_.mask(frame, observedObject(T_coarse), T_coarse);
+      result.timings.mask += watch.lap();
+      if (cv::countNonZero(masked.mask) == 0) return lost(result, total);  // not where the pose says
+      const std::vector<int> kept = keepFeaturesInside(features, masked.mask);
+      std::erase_if(previous_inliers, [&](FeatureMatch& m) { return (m.second = kept[std::size_t(m.second)]) < 0; });
     }
 
     // Pose graph over the selected keyframes and the current frame (paper IV-C, IV-D).
@@ -146,7 +174,7 @@ class Tracker {
       for (int b = a + 1; b <= last; ++b) {
         const std::vector<FeatureMatch>* edge_matches;
         if (b == last) {
-          if (nodes[a]->id == previous_->id && coarse_ok) current_matches[a] = inlierMatches(matches, coarse.inliers);
+          if (nodes[a]->id == previous_->id && previous_ok) current_matches[a] = std::move(previous_inliers);
           else current_matches[a] = edgeCorrespondences(*nodes[a], current, poses[a], poses[b], result.timings, watch);
           edge_matches = &current_matches[a];
         } else {
@@ -172,6 +200,18 @@ class Tracker {
       return lost(result, total);
     }
     result.timings.solve = watch.lap();
+    if constexpr (kPropagatedMasks) {
+      // The mask came from the coarse pose (the last pose when RANSAC failed); what the tracker
+      // keeps of this frame (a keyframe, the next frame's rendering) is cut with the final pose.
+      const cv::Mat refined = masks_.mask(frame, observedObject(result.T_cam_obj), result.T_cam_obj);
+      if (cv::countNonZero(refined) > 0) {
+        masked.mask = result.mask = refined;
+        keepFeaturesInside(current.features, refined);
+        current = makeKeyframe(id, masked, refined, std::move(current.features), result.T_cam_obj,
+                               settings_.dense_grid_step);
+      }
+      result.timings.mask += watch.lap();
+    }
 
     // Paper IV-E: keep the frame when it shows a novel view (a copy only then: the graph is done,
     // and the features move on to the next frame's coarse step).
@@ -180,7 +220,7 @@ class Tracker {
         pool_.isNovelView(result.T_cam_obj.rotation(), settings_.new_keyframe_rotation_deg * std::numbers::pi / 180.0)) {
       if (const int evicted = pool_.add(current); evicted >= 0) forget(evicted);
     }
-    previous_ = Previous{id, result.T_cam_obj, std::move(current.features)};
+    previous_ = Previous{id, result.T_cam_obj, std::move(current.features), current.points};
     lost_streak_ = 0;
     result.timings.graph += watch.lap();
     result.timings.total = total.lap();
@@ -192,7 +232,17 @@ class Tracker {
     int id;
     SE3d T_cam_obj;
     FrameFeatures features;
+    cv::Mat points;  ///< its object points on the dense grid
   };
+
+  /// What the tracker has seen of the object, for propagated masks: the previous good frame and
+  /// the keyframes the graph would pick for this pose.
+  std::vector<ObservedSurface> observedObject(const SE3d& T_cam_obj) const {
+    std::vector<ObservedSurface> object{{previous_->points, previous_->T_cam_obj}};
+    for (const std::size_t k : pool_.select(T_cam_obj.rotation(), settings_.max_keyframes))
+      object.push_back({pool_[k].points, pool_[k].T_cam_obj});
+    return object;
+  }
 
   TrackResult& lost(TrackResult& result, Stopwatch& total) {
     ++lost_streak_;
@@ -269,13 +319,6 @@ class Tracker {
     }
     if (compared == 0 || 4 * compared < valid) return 0.0;
     return double(agreeing) / double(compared);
-  }
-
-  RgbdFrame withMask(const RgbdFrame& frame, StageTimings& timings, Stopwatch& watch) {
-    RgbdFrame masked = frame;  // shares the image buffers
-    masked.mask = masks_.mask(frame);
-    timings.mask = watch.lap();
-    return masked;
   }
 
   static std::vector<FeatureMatch> inlierMatches(const std::vector<FeatureMatch>& matches, const std::vector<int>& inliers) {

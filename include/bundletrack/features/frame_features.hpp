@@ -1,5 +1,6 @@
 #pragma once
 
+#include <cmath>
 #include <vector>
 
 #include <Eigen/Core>
@@ -18,6 +19,27 @@ struct FrameFeatures {
 
   std::size_t size() const { return points.size(); }
 };
+
+/// Keeps the features whose pixel lies on the mask (CV_8UC1, nonzero); returns, for every old
+/// index, the new one (-1: dropped).
+inline std::vector<int> keepFeaturesInside(FrameFeatures& features, const cv::Mat& mask) {
+  std::vector<int> kept(features.size(), -1);
+  int count = 0;
+  for (std::size_t k = 0; k < features.size(); ++k) {
+    const int u = int(std::lround(features.pixels[k].x)), v = int(std::lround(features.pixels[k].y));
+    if (u < 0 || v < 0 || u >= mask.cols || v >= mask.rows || !mask.at<uchar>(v, u)) continue;
+    features.pixels[std::size_t(count)] = features.pixels[k];
+    features.points[std::size_t(count)] = features.points[k];
+    features.normals[std::size_t(count)] = features.normals[k];
+    if (count != int(k)) features.descriptors.row(int(k)).copyTo(features.descriptors.row(count));
+    kept[k] = count++;
+  }
+  features.pixels.resize(std::size_t(count));
+  features.points.resize(std::size_t(count));
+  features.normals.resize(std::size_t(count));
+  if (!features.descriptors.empty()) features.descriptors = features.descriptors.rowRange(0, count);
+  return kept;
+}
 
 /// A feature correspondence: index into the first and into the second frame's features.
 struct FeatureMatch {

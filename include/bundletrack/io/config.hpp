@@ -30,7 +30,24 @@ struct Config {
   OrbSettings orb;
   AkazeSettings akaze;
   TrackerSettings tracker;
+  std::string masks = "given";  ///< given: every frame's mask from the data | propagated: the first one only
+  PropagatedMaskSettings propagated_masks;
 };
+
+/// A setting chosen by name: section.key, where it lives, and the names it accepts.
+struct ConfigChoice {
+  const char* section;
+  const char* key;
+  std::string* value;
+  std::vector<std::string> names;
+  const char* meaning;
+};
+
+inline std::vector<ConfigChoice> configChoices(Config& c) {
+  return {{"features", "type", &c.features, {"sift", "orb", "akaze"}, "keypoint detector and descriptor"},
+          {"masks", "source", &c.masks, {"given", "propagated"},
+           "given: every frame's mask from the data; propagated: from the first mask alone"}};
+}
 
 /// One entry of the YAML file: section.key, where it lives, its valid range, unit and meaning.
 struct ConfigParameter {
@@ -47,6 +64,7 @@ inline std::vector<ConfigParameter> configParameters(Config& c) {
   constexpr double inf = std::numeric_limits<double>::infinity();
   auto& depth = c.sequence.frame.depth_filter;
   auto& t = c.tracker;
+  auto& m = c.propagated_masks;
   return {
       {"depth", "scale", &c.sequence.depth_scale, 1e-6, 1.0, "m/unit", "metres per unit of the 16-bit depth images"},
       {"depth", "min_depth", &depth.min_depth, 0.0, 100.0, "m", "closer readings are invalid"},
@@ -80,10 +98,18 @@ inline std::vector<ConfigParameter> configParameters(Config& c) {
       {"graph", "agreement_distance", &t.agreement_distance, 0.0, 1.0, "m", "on the surface: within this distance"},
       {"graph", "recovery_min_inliers", &t.recovery_min_inliers, 3, 100000, "", "RANSAC inliers needed to restart after lost frames"},
       {"graph", "gauss_newton_iterations", &t.gauss_newton.iterations, 0, 1000, "", "paper IV-D, original code: 7"},
+      {"masks", "search_margin_px", &m.search_margin_px, 0, 10000, "px", "propagated: keypoints are searched this far around the last pose's silhouette"},
+      {"masks", "growth_px", &m.growth_px, 0, 10000, "px", "propagated: the mask reaches this far beyond the rendered silhouette"},
+      {"masks", "depth_agreement", &m.depth_agreement, 0.0, 1.0, "m", "propagated: observed vs rendered depth that seeds the mask"},
+      {"masks", "depth_continuity", &m.depth_continuity, 0.0, 1.0, "m", "propagated: largest depth step between neighbouring mask pixels (up to 1 m; times z^2 beyond)"},
+      {"masks", "hull_dilation_px", &m.hull_dilation_px, 0, 1000, "px", "propagated: slack of the first view's silhouette"},
+      {"masks", "hull_depth_tolerance", &m.hull_depth_tolerance, 0.0, 1.0, "m", "propagated: slack in front of the first view's surface"},
+      {"masks", "object_size_factor", &m.object_size_factor, 0.0, 100.0, "", "propagated, after lost: searched surfaces are at most this times the first view's extent"},
+      {"masks", "min_area_fraction", &m.min_area_fraction, 0.0, 1.0, "", "propagated, after lost: and show this fraction of the first view's area"},
   };
 }
 
-/// Reads a YAML configuration (sections and keys of configParameters, plus features.type) over
+/// Reads a YAML configuration (sections and keys of configParameters, plus the named choices of configChoices) over
 /// the defaults. An unknown key, a value that is not a number, a non-integer for an integer
 /// setting, or a value out of range is an InputError naming the file and the key.
 inline Config loadConfig(const std::filesystem::path& path) {
@@ -101,17 +127,24 @@ inline Config loadConfig(const std::filesystem::path& path) {
   }
   Config config;
   auto parameters = configParameters(config);
+  auto choices = configChoices(config);
   const cv::FileNode root = storage.root();
   if (!root.isMap() && !root.empty()) throw InputError(path, "expected sections of key: value pairs");
   for (const cv::FileNode section : root) {
     if (!section.isMap()) throw InputError(path, "'" + section.name() + "' must be a section of key: value pairs");
     for (const cv::FileNode node : section) {
       const std::string name = section.name() + "." + node.name();
-      if (name == "features.type") {
-        if (!node.isString()) throw InputError(path, name + " must be sift, orb or akaze");
-        config.features = std::string(node);
-        if (config.features != "sift" && config.features != "orb" && config.features != "akaze")
-          throw InputError(path, name + " = '" + config.features + "': expected sift, orb or akaze");
+      const auto choice = std::find_if(choices.begin(), choices.end(), [&](const ConfigChoice& c) {
+        return section.name() == c.section && node.name() == c.key;
+      });
+      if (choice != choices.end()) {
+        const std::string value = node.isString() ? std::string(node) : std::string();
+        if (std::find(choice->names.begin(), choice->names.end(), value) == choice->names.end()) {
+          std::string expected;
+          for (const std::string& n : choice->names) expected += (expected.empty() ? "" : " | ") + n;
+          throw InputError(path, name + " = '" + value + "': expected " + expected);
+        }
+        *choice->value = value;
         continue;
       }
       const auto found = std::find_if(parameters.begin(), parameters.end(), [&](const ConfigParameter& p) {
@@ -149,7 +182,12 @@ inline std::string printConfig(Config config) {
     if (section != p.section) {
       section = p.section;
       out << section << ":\n";
-      if (section == "features") out << "  # sift | orb | akaze\n  type: " << config.features << "\n";
+      for (const ConfigChoice& c : configChoices(config)) {
+        if (section != c.section) continue;
+        std::string names;
+        for (const std::string& n : c.names) names += (names.empty() ? "" : " | ") + n;
+        out << "  # " << c.meaning << " (" << names << ")\n  " << c.key << ": " << *c.value << "\n";
+      }
     }
     out << "  # " << p.meaning << (*p.unit ? std::string(" [") + p.unit + "]" : "") << "\n  " << p.key << ": ";
     std::visit([&](auto* value) {

@@ -1,18 +1,9 @@
 #pragma once
 
-#include <concepts>
-
 #include "bundletrack/core/error.hpp"
-#include "bundletrack/core/rgbd_frame.hpp"
+#include "bundletrack/masks/mask_source.hpp"
 
 namespace bundletrack {
-
-/// Where each frame's object mask comes from. `mask(frame)` returns CV_8UC1, 255 on the object;
-/// an all-zero mask means the object is not visible in this frame.
-template <typename T>
-concept MaskSource = requires(T& source, const RgbdFrame& frame) {
-  { source.mask(frame) } -> std::same_as<cv::Mat>;
-};
 
 /// Masks that come with the data (the frame's own mask, e.g. from masks/<name>.png).
 struct GivenMasks {

@@ -40,7 +40,7 @@ class CoarseTracker {
     Stopwatch watch;
     reference_ = correspondences_.detect(frame);
     T_cam_obj_ = T_cam_obj;
-    TrackResult result{T_cam_obj, TrackStatus::Tracked, int(reference_->size()), 0, 0, {}};
+    TrackResult result{T_cam_obj, TrackStatus::Tracked, int(reference_->size()), 0, 0, frame.mask, {}};
     result.timings.features = result.timings.total = watch.lap();
     return result;
   }
@@ -48,6 +48,7 @@ class CoarseTracker {
   TrackResult track(const RgbdFrame& frame) {
     if (!reference_) throw InputError("frame " + frame.name, "track() called before initialize()");
     TrackResult result;
+    result.mask = frame.mask;
     Stopwatch watch, total;
     FrameFeatures features = correspondences_.detect(frame);
     result.timings.features = watch.lap();

@@ -2,6 +2,8 @@
 
 #include <string_view>
 
+#include <opencv2/core.hpp>
+
 #include "bundletrack/core/se3.hpp"
 
 namespace bundletrack {
@@ -33,6 +35,7 @@ struct TrackResult {
   int keypoints = 0;  ///< features detected on this frame
   int matches = 0;  ///< matches with the previous frame
   int inliers = 0;  ///< RANSAC inliers among them
+  cv::Mat mask;  ///< the object mask the frame was tracked with; empty when none was made
   StageTimings timings;
 };
 

@@ -1,0 +1,63 @@
+#pragma once
+
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+#include <Eigen/Core>
+#include <opencv2/core.hpp>
+
+namespace bundletrack {
+
+/// One surface of the depth image: pixels joined by depth-continuous 4-neighbour steps.
+struct DepthSegment {
+  int pixels = 0;
+  Eigen::Vector3f low = Eigen::Vector3f::Constant(INFINITY), high = -Eigen::Vector3f::Constant(INFINITY);
+
+  float diagonal() const { return pixels > 0 ? (high - low).norm() : 0.0f; }
+};
+
+/// Largest depth step between neighbouring pixels of one surface at depth z: `continuity` metres
+/// up to 1 m, growing with z^2 beyond, as the depth resolution of structured-light and stereo
+/// sensors does (Kinect v1: ~3 mm steps at 1 m, ~13 mm at 2 m).
+inline float continuityAt(float z, float continuity) { return continuity * std::max(1.0f, z * z); }
+
+/// Splits the valid depth into surfaces that neighbouring pixels join when their depths differ by
+/// at most continuityAt(depth, continuity). `labels` (CV_32SC1) gets each pixel's segment index, -1 where
+/// depth is invalid; returns the segments with their sizes and 3-D bounding boxes.
+inline std::vector<DepthSegment> segmentDepth(const cv::Mat& depth, const cv::Mat& points, float continuity,
+                                              cv::Mat& labels) {
+  labels.create(depth.size(), CV_32SC1);
+  labels.setTo(-1);
+  std::vector<DepthSegment> segments;
+  std::vector<cv::Point> frontier;
+  for (int v = 0; v < depth.rows; ++v) {
+    for (int u = 0; u < depth.cols; ++u) {
+      if (depth.at<float>(v, u) <= 0.0f || labels.at<int>(v, u) >= 0) continue;
+      const int id = int(segments.size());
+      DepthSegment& segment = segments.emplace_back();
+      labels.at<int>(v, u) = id;
+      frontier.assign(1, {u, v});
+      while (!frontier.empty()) {
+        const cv::Point p = frontier.back();
+        frontier.pop_back();
+        const cv::Vec3f& x = points.at<cv::Vec3f>(p);
+        ++segment.pixels;
+        segment.low = segment.low.cwiseMin(Eigen::Vector3f(x[0], x[1], x[2]));
+        segment.high = segment.high.cwiseMax(Eigen::Vector3f(x[0], x[1], x[2]));
+        const float z = depth.at<float>(p);
+        for (const cv::Point step : {cv::Point(1, 0), cv::Point(-1, 0), cv::Point(0, 1), cv::Point(0, -1)}) {
+          const cv::Point q = p + step;
+          if (q.x < 0 || q.y < 0 || q.x >= depth.cols || q.y >= depth.rows || labels.at<int>(q) >= 0) continue;
+          const float zq = depth.at<float>(q);
+          if (zq <= 0.0f || std::abs(zq - z) > continuityAt(z, continuity)) continue;
+          labels.at<int>(q) = id;
+          frontier.push_back(q);
+        }
+      }
+    }
+  }
+  return segments;
+}
+
+}  // namespace bundletrack

@@ -1,0 +1,205 @@
+#pragma once
+
+#include <cmath>
+#include <optional>
+#include <span>
+#include <vector>
+
+#include <opencv2/core.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "bundletrack/core/error.hpp"
+#include "bundletrack/graph/keyframe.hpp"
+#include "bundletrack/masks/depth_segments.hpp"
+#include "bundletrack/masks/first_view_hull.hpp"
+#include "bundletrack/masks/mask_source.hpp"
+
+namespace bundletrack {
+
+struct PropagatedMaskSettings {
+  /// Keypoints are searched this far around the object's silhouette at the last pose: hand-held
+  /// motion of 1 m/s at 30 Hz and 0.6 m moves the object ~30 px at f = 525 px.
+  int search_margin_px = 40;
+  /// The mask may reach this far beyond the rendered silhouette, where surface not seen before
+  /// comes into view.
+  int growth_px = 8;
+  /// Observed depth within this of the rendered object depth seeds the mask: a few mm of coarse
+  /// pose error plus 3 sigma of Kinect noise at 1.5 m (5 mm) plus grazing-angle spread.
+  float depth_agreement = 0.02f;
+  /// Neighbouring pixels of one surface differ by less than this in depth up to 1 m, growing with
+  /// z^2 beyond (continuityAt): 1 px is ~2 mm at 1 m, a 60 degree slant triples that, and objects
+  /// stand out from their background by more.
+  float depth_continuity = 0.01f;
+  int hull_dilation_px = 5;  ///< pose and depth/colour registration error (1-3 px) of the first view
+  float hull_depth_tolerance = 0.015f;  ///< metres in front of the first view's surface still inside
+  /// After the object was lost, keypoints are searched on surfaces of about its size: at most this
+  /// many times its first view's extent (a view from another side can be larger than the first) ...
+  float object_size_factor = 2.0f;
+  /// ... showing at least this fraction of the first view's pixel area scaled to their depth (a
+  /// partly hidden or edge-on view shows less; depth dropouts cut the background into crumbs).
+  float min_area_fraction = 0.25f;
+};
+
+/// Object masks from the first one alone (replacing the paper's video segmentation network): the
+/// object surfaces seen so far are rendered under the coarse pose; pixels whose depth agrees seed
+/// the mask, which then grows over depth-continuous pixels up to growth_px beyond the rendered
+/// silhouette, never leaving the first view's hull (FirstViewHull). A mask that comes out empty
+/// means the object is not where the pose says: the tracker reports the frame lost.
+class PropagatedMasks {
+ public:
+  using Settings = PropagatedMaskSettings;
+
+  explicit PropagatedMasks(Settings settings = {}) : settings_(settings) {}
+
+  void start(const RgbdFrame& first, const PinholeCameraf& camera, const SE3d& T_cam_obj, int grid_step) {
+    if (first.mask.empty() || cv::countNonZero(first.mask) == 0)
+      throw InputError("frame " + first.name, "propagated masks need a non-empty mask of the first frame");
+    camera_ = camera;
+    grid_step_ = grid_step;
+    hull_ = FirstViewHull(first, camera, T_cam_obj, settings_.hull_dilation_px, settings_.hull_depth_tolerance);
+    const cv::Mat seen = first.mask & (first.depth > 0.0f);
+    first_area_ = cv::countNonZero(seen);
+    first_depth_ = float(cv::mean(first.depth, seen)[0]);
+    started_ = true;
+  }
+
+  cv::Mat searchRegion(const RgbdFrame& frame, std::span<const ObservedSurface> object,
+                       const std::optional<SE3d>& T_guess) const {
+    requireStarted(frame);
+    if (!T_guess) return objectSizedSurfaces(frame);
+    cv::Mat silhouette = renderDepth(object, *T_guess, gridSize(frame)) > 0.0f;
+    const int margin = (settings_.search_margin_px + grid_step_ - 1) / grid_step_;
+    cv::dilate(silhouette, silhouette, cv::getStructuringElement(cv::MORPH_ELLIPSE, {2 * margin + 1, 2 * margin + 1}));
+    cv::resize(silhouette, silhouette, frame.depth.size(), 0.0, 0.0, cv::INTER_NEAREST);
+    return silhouette & (frame.depth > 0.0f);
+  }
+
+  cv::Mat mask(const RgbdFrame& frame, std::span<const ObservedSurface> object, const SE3d& T_cam_obj) const {
+    requireStarted(frame);
+    cv::Mat rendered;
+    cv::resize(renderDepth(object, T_cam_obj, gridSize(frame)), rendered, frame.depth.size(), 0.0, 0.0, cv::INTER_NEAREST);
+    cv::Mat region;
+    const int g = settings_.growth_px;
+    cv::dilate(rendered > 0.0f, region, cv::getStructuringElement(cv::MORPH_ELLIPSE, {2 * g + 1, 2 * g + 1}));
+    const cv::Rect box = cv::boundingRect(region);
+
+    // Candidates: valid depth near the silhouette, inside the hull; seeds: those that agree.
+    enum : uchar { kNone = 0, kCandidate = 1, kObject = 255 };
+    cv::Mat label(frame.depth.size(), CV_8UC1, cv::Scalar(kNone));
+    const SE3d T_obj_cam = T_cam_obj.inverse();
+    std::vector<cv::Point> frontier;
+    for (int v = box.y; v < box.y + box.height; ++v) {
+      for (int u = box.x; u < box.x + box.width; ++u) {
+        const float z = frame.depth.at<float>(v, u);
+        if (!region.at<uchar>(v, u) || z <= 0.0f) continue;
+        const cv::Vec3f& p = frame.points.at<cv::Vec3f>(v, u);
+        if (!hull_.contains(T_obj_cam * Eigen::Vector3d(p[0], p[1], p[2]))) continue;
+        const float expected = rendered.at<float>(v, u);
+        const bool agrees = expected > 0.0f && std::abs(z - expected) <= settings_.depth_agreement;
+        label.at<uchar>(v, u) = agrees ? kObject : kCandidate;
+        if (agrees) frontier.emplace_back(u, v);
+      }
+    }
+    // Grow over depth-continuous candidates (4-neighbourhood flood fill from the seeds).
+    while (!frontier.empty()) {
+      const cv::Point p = frontier.back();
+      frontier.pop_back();
+      const float z = frame.depth.at<float>(p);
+      for (const cv::Point step : {cv::Point(1, 0), cv::Point(-1, 0), cv::Point(0, 1), cv::Point(0, -1)}) {
+        const cv::Point q = p + step;
+        if (!box.contains(q) || label.at<uchar>(q) != kCandidate) continue;
+        if (std::abs(frame.depth.at<float>(q) - z) > continuityAt(z, settings_.depth_continuity)) continue;
+        label.at<uchar>(q) = kObject;
+        frontier.push_back(q);
+      }
+    }
+    return label == kObject;
+  }
+
+ private:
+  void requireStarted(const RgbdFrame& frame) const {
+    if (!started_) throw InputError("frame " + frame.name, "propagated masks used before start() with a first mask");
+  }
+
+  /// Where the object may be when its pose is unknown: the depth-continuous surfaces of about its
+  /// size (walls, tables and whatever holds the object are larger, crumbs of background smaller);
+  /// the whole valid depth when there is none.
+  cv::Mat objectSizedSurfaces(const RgbdFrame& frame) const {
+    cv::Mat labels;
+    const std::vector<DepthSegment> segments = segmentDepth(frame.depth, frame.points, settings_.depth_continuity, labels);
+    std::vector<uchar> keep(segments.size());
+    bool any = false;
+    for (std::size_t k = 0; k < segments.size(); ++k) {
+      const float z = 0.5f * (segments[k].low.z() + segments[k].high.z());
+      const float expected_area = float(first_area_) * (first_depth_ * first_depth_) / (z * z);
+      keep[k] = float(segments[k].pixels) >= settings_.min_area_fraction * expected_area &&
+                segments[k].diagonal() <= settings_.object_size_factor * hull_.extent();
+      any = any || keep[k];
+    }
+    if (!any) return frame.depth > 0.0f;
+    cv::Mat region(frame.depth.size(), CV_8UC1);
+    for (int v = 0; v < region.rows; ++v)
+      for (int u = 0; u < region.cols; ++u) {
+        const int id = labels.at<int>(v, u);
+        region.at<uchar>(v, u) = id >= 0 && keep[std::size_t(id)] ? 255 : 0;
+      }
+    return region;
+  }
+
+  cv::Size gridSize(const RgbdFrame& frame) const {
+    return {(frame.depth.cols + grid_step_ - 1) / grid_step_, (frame.depth.rows + grid_step_ - 1) / grid_step_};
+  }
+
+  /// Depth of the observed surfaces under T_cam_obj on the grid (z-buffer, one grid cell per
+  /// point), with one-cell holes between neighbouring points closed; 0 where nothing lands.
+  cv::Mat renderDepth(std::span<const ObservedSurface> object, const SE3d& T_cam_obj, cv::Size size) const {
+    const PinholeCameraf grid = downsampledCamera(camera_, grid_step_);
+    cv::Mat depth(size, CV_32FC1, cv::Scalar(0.0f));
+    for (const ObservedSurface& surface : object) {
+      const Eigen::Matrix<float, 3, 4> T = (T_cam_obj * surface.T_cam_obj.inverse()).matrix().topRows<3>().cast<float>();
+      for (int y = 0; y < surface.points.rows; ++y) {
+        for (int x = 0; x < surface.points.cols; ++x) {
+          const cv::Vec3f& p = surface.points.at<cv::Vec3f>(y, x);
+          if (p[2] <= 0.0f) continue;
+          const Eigen::Vector3f q = T.leftCols<3>() * Eigen::Vector3f(p[0], p[1], p[2]) + T.col(3);
+          if (q.z() <= 0.0f) continue;
+          const int u = int(std::lround(grid.fx * q.x() / q.z() + grid.cx));
+          const int v = int(std::lround(grid.fy * q.y() / q.z() + grid.cy));
+          if (u < 0 || v < 0 || u >= size.width || v >= size.height) continue;
+          float& d = depth.at<float>(v, u);
+          if (d == 0.0f || q.z() < d) d = q.z();
+        }
+      }
+    }
+    cv::Mat closed = depth.clone();
+    for (int v = 0; v < size.height; ++v) {
+      for (int u = 0; u < size.width; ++u) {
+        if (depth.at<float>(v, u) > 0.0f) continue;
+        float nearest = 0.0f;
+        int neighbours = 0;
+        for (int dv = -1; dv <= 1; ++dv) {
+          for (int du = -1; du <= 1; ++du) {
+            const int uu = u + du, vv = v + dv;
+            if (uu < 0 || vv < 0 || uu >= size.width || vv >= size.height) continue;
+            const float d = depth.at<float>(vv, uu);
+            if (d <= 0.0f) continue;
+            ++neighbours;
+            nearest = nearest == 0.0f ? d : std::min(nearest, d);
+          }
+        }
+        if (neighbours >= 3) closed.at<float>(v, u) = nearest;  // inside the surface, not along its rim
+      }
+    }
+    return closed;
+  }
+
+  Settings settings_;
+  PinholeCameraf camera_{};
+  int grid_step_ = 1;
+  FirstViewHull hull_;
+  int first_area_ = 0;  ///< pixels of the first mask with depth
+  float first_depth_ = 0.0f;  ///< their mean depth
+  bool started_ = false;
+};
+
+}  // namespace bundletrack
