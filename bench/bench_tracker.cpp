@@ -1,9 +1,12 @@
-// bench_tracker [--sequence DIR ...] [--frames N]
+// bench_tracker [--sequence DIR ...] [--frames N] [--memory-every N]
 // Runs the default tracker on each sequence (or on a synthetic one rendered in memory) and prints,
 // per stage, the median and 90th percentile of the milliseconds per frame, the share of the
 // median frame, and frames per second (tracking only, and with reading + preprocessing).
+// --memory-every N also prints, every N frames, the keyframes in the pool and the process's
+// resident and peak resident memory (Linux /proc/self/status).
 #include <algorithm>
 #include <cstdio>
+#include <fstream>
 #include <string>
 #include <vector>
 
@@ -45,16 +48,35 @@ void report(const std::string& name, const Stages& s) {
               1000.0 * double(s.total.size()) / sum, 1000.0 * double(s.total.size()) / (sum + sum_read));
 }
 
+/// VmRSS and VmHWM of this process in MiB (0 where /proc is not available).
+std::pair<double, double> residentMemoryMiB() {
+  std::ifstream status("/proc/self/status");
+  double rss = 0.0, peak = 0.0;
+  for (std::string line; std::getline(status, line);) {
+    if (line.rfind("VmRSS:", 0) == 0) rss = std::stod(line.substr(6)) / 1024.0;
+    if (line.rfind("VmHWM:", 0) == 0) peak = std::stod(line.substr(6)) / 1024.0;
+  }
+  return {rss, peak};
+}
+
 template <typename FrameAt>
-Stages track(const bt::PinholeCameraf& camera, std::size_t frames, FrameAt&& frame_at) {
+Stages track(const bt::PinholeCameraf& camera, std::size_t frames, int memory_every, FrameAt&& frame_at) {
   bt::DefaultTracker tracker(camera);
   Stages stages;
+  if (memory_every > 0) std::printf("%8s %10s %12s %13s %6s\n", "frame", "keyframes", "resident MiB", "peak MiB", "lost");
+  int lost = 0;
   for (std::size_t i = 0; i < frames; ++i) {
     bt::Stopwatch read;
     const auto [frame, pose] = frame_at(i);
     const double read_ms = read.lap();
     const bt::TrackResult result = i == 0 ? tracker.initialize(frame, pose) : tracker.track(frame);
+    lost += result.status == bt::TrackStatus::Lost;
     if (i > 0) stages.add(read_ms, result.timings);
+    if (memory_every > 0 && ((i + 1) % std::size_t(memory_every) == 0 || i + 1 == frames)) {
+      const auto [rss, peak] = residentMemoryMiB();
+      std::printf("%8zu %10zu %12.1f %13.1f %6d\n", i + 1, tracker.keyframes().size(), rss, peak, lost);
+      std::fflush(stdout);
+    }
   }
   return stages;
 }
@@ -63,13 +85,14 @@ Stages track(const bt::PinholeCameraf& camera, std::size_t frames, FrameAt&& fra
 
 int main(int argc, char** argv) {
   std::vector<std::string> sequences;
-  int frames = 150;
+  int frames = 150, memory_every = 0;
   for (int i = 1; i + 1 < argc; i += 2) {
     const std::string arg = argv[i];
     if (arg == "--sequence") sequences.emplace_back(argv[i + 1]);
     else if (arg == "--frames") frames = std::atoi(argv[i + 1]);
+    else if (arg == "--memory-every") memory_every = std::atoi(argv[i + 1]);
     else {
-      std::fprintf(stderr, "usage: bench_tracker [--sequence DIR ...] [--frames N]\n");
+      std::fprintf(stderr, "usage: bench_tracker [--sequence DIR ...] [--frames N] [--memory-every N]\n");
       return 2;
     }
   }
@@ -80,14 +103,14 @@ int main(int argc, char** argv) {
       const bt::synth::SyntheticScene scene(settings);
       const auto camera = settings.camera.cast<float>();
       report("synthetic hand-held box (rendering counted as reading)",
-             track(camera, std::size_t(frames), [&](std::size_t i) {
+             track(camera, std::size_t(frames), memory_every, [&](std::size_t i) {
                const auto f = scene.frame(int(i));
                return std::pair(bt::makeFrame(std::to_string(i), f.color, f.depth, f.mask, camera), f.T_cam_obj);
              }));
     }
     for (const auto& dir : sequences) {
       const bt::io::YcbineoatSequence sequence(dir);
-      report(dir, track(sequence.camera().cast<float>(), sequence.size(), [&](std::size_t i) {
+      report(dir, track(sequence.camera().cast<float>(), sequence.size(), memory_every, [&](std::size_t i) {
                return std::pair(sequence.frame(i), sequence.hasGroundTruth() ? sequence.groundTruthPose(i) : bt::SE3d());
              }));
     }

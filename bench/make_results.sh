@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Regenerates bench/RESULTS.md from a fresh run of the benchmarks (build first; see README).
-# Usage: bash bench/make_results.sh [build-dir]   (a few minutes on 2 cores)
+# Usage: bash bench/make_results.sh [build-dir]   (about 30 minutes on 2 cores: the 3,000-frame
+# memory run takes half of it, the Open3D peers a third; the peers need python3-open3d)
 set -euo pipefail
 build=${1:-build}
 out=$(dirname "$0")/RESULTS.md
@@ -78,11 +79,35 @@ depth=$("$build/bin/bench_depth_processing" --benchmark_format=csv 2>/dev/null)
   echo
   echo '```'
   args=()
+  sequences=()
   for s in "${BUNDLETRACK_DATA:-$(dirname "$0")/../../shared/data}"/7scenes_objects/*/; do
-    [ -d "$s/rgb" ] && args+=(--sequence "$s")
+    [ -d "$s/rgb" ] && args+=(--sequence "$s") && sequences+=("$s")
   done
   "$build/bin/bench_tracker" --frames 150
   [ ${#args[@]} -gt 0 ] && "$build/bin/bench_tracker" "${args[@]}"
   echo '```'
+  echo
+  echo "## Memory over a 3,000-frame synthetic run (bench_tracker --frames 3000 --memory-every 250)"
+  echo
+  echo "Resident and peak resident memory of the whole process (rendering included) while the"
+  echo "default tracker runs; the pool holds at most graph.pool_capacity = 200 keyframes, and frames"
+  echo "join it only with a novel view (10 degrees from every keyframe)."
+  echo
+  echo '```'
+  "$build/bin/bench_tracker" --frames 3000 --memory-every 250 | sed -n '1,/^$/p' | sed '/^$/d'
+  echo '```'
+  echo
+  echo "## Peers: Open3D frame-to-frame registration (bench/peers.py)"
+  echo
+  if [ ${#sequences[@]} -gt 0 ] && /usr/bin/python3 -c "import open3d, cv2" 2>/dev/null; then
+    echo "Same sequences, same run, first pose from the annotation, given masks, no re-initialisation;"
+    echo "every method's poses scored by bundletrack_eval. Milliseconds per frame count everything from"
+    echo "the image files to the pose on this CPU machine (Open3D $(/usr/bin/python3 -c 'import open3d; print(open3d.__version__)'),"
+    echo "Debian build); ours / method time < 1 means ours is faster. A failed step keeps the last pose."
+    echo
+    /usr/bin/python3 "$(dirname "$0")/peers.py" --build "$build" --out "$build/peers" "${sequences[@]}"
+  else
+    echo "Not run: needs ../shared/data sequences and the Debian packages python3-open3d, python3-opencv."
+  fi
 } > "$out"
 echo "wrote $out"

@@ -121,7 +121,7 @@ int run(Tracker tracker, const bt::io::YcbineoatSequence& sequence, const Option
   std::ofstream csv(options.out / "track.csv");
   const bool scored = sequence.hasGroundTruth() && sequence.hasModel();
   const bool propagated = options.config.masks == "propagated";
-  csv << "frame,status,keypoints,matches,inliers,mask_ms,features_ms,matching_ms,ransac_ms,graph_ms,solve_ms,total_ms"
+  csv << "frame,status,keypoints,matches,inliers,read_ms,mask_ms,features_ms,matching_ms,ransac_ms,graph_ms,solve_ms,total_ms"
       << (scored ? ",rotation_error_deg,translation_error_cm" : "") << (propagated ? ",mask_iou\n" : "\n");
   std::vector<bt::SE3d> truth, estimate;
   int lost = 0;
@@ -130,7 +130,9 @@ int run(Tracker tracker, const bt::io::YcbineoatSequence& sequence, const Option
   if (options.viz) overlay.emplace(options.out, sequence);
   std::vector<double> rotation_errors, translation_errors, mask_ious;
   for (std::size_t i = 0; i < sequence.size(); ++i) {
+    bt::Stopwatch reading;
     bt::RgbdFrame frame = sequence.frame(i);
+    const double read_ms = reading.lap();
     const cv::Mat dataset_mask = frame.mask;
     if (propagated && i > 0) frame.mask = cv::Mat();  // the tracker must not see it
     if (!propagated && i > 0 && frame.mask.empty())
@@ -143,7 +145,7 @@ int run(Tracker tracker, const bt::io::YcbineoatSequence& sequence, const Option
     bt::io::writePose(options.out / "poses" / (frame.name + ".txt"), result.T_cam_obj);
     const auto& t = result.timings;
     csv << frame.name << ',' << bt::statusName(result.status) << ',' << result.keypoints << ',' << result.matches << ','
-        << result.inliers << ',' << t.mask << ',' << t.features << ',' << t.matching << ',' << t.ransac << ',' << t.graph
+        << result.inliers << ',' << read_ms << ',' << t.mask << ',' << t.features << ',' << t.matching << ',' << t.ransac << ',' << t.graph
         << ',' << t.solve << ',' << t.total;
     if (scored) {
       truth.push_back(sequence.groundTruthPose(i));

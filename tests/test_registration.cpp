@@ -167,7 +167,28 @@ TEST_CASE("mutual matching with the ratio test is symmetric and gated by a known
   CHECK(int(forward.size()) - correct <= 2);
   // A gate with the true relative pose (identity here) keeps the correct matches; one that is off
   // by 5 cm removes them all.
-  CHECK(bt::matchFeatures(a, b, settings, bt::MatchGate{bt::SE3f(), 0.02f, 45.0f}).size() == std::size_t(correct));
+  bt::MatchSettings exhaustive = settings;
+  exhaustive.guided = false;
+  const bt::MatchGate truth{bt::SE3f(), 0.02f, 45.0f};
+  const auto gated = bt::matchFeatures(a, b, exhaustive, truth);
+  CHECK(gated.size() == std::size_t(correct));
   const bt::SE3f shifted(bt::SO3f(), Eigen::Vector3f(0.05f, 0.0f, 0.0f));
-  CHECK(bt::matchFeatures(a, b, settings, bt::MatchGate{shifted, 0.02f, 45.0f}).empty());
+  CHECK(bt::matchFeatures(a, b, exhaustive, bt::MatchGate{shifted, 0.02f, 45.0f}).empty());
+  // Guided matching finds every gated exhaustive match (the nearest neighbour overall is the
+  // nearest among the gated candidates, and the runner-up among them is no closer); with the
+  // true pose it finds all 40 planted pairs, and the only others pair a keypoint without a true
+  // partner (a's rows 0..9 and 50..59) with a random neighbour of b within the 2 cm gate.
+  const auto guided = bt::matchFeatures(a, b, settings, truth);
+  for (const auto& m : gated) CHECK(std::find(guided.begin(), guided.end(), m) != guided.end());
+  int planted = 0, other = 0;
+  for (const auto& m : guided) {
+    if (m.first == m.second + 10 && m.second < 40) ++planted;
+    else other += m.first < 10 || m.first >= 50 ? 0 : 1;
+    CHECK(std::abs(m.first - (m.second + 10)) <= 2);
+  }
+  CHECK(planted == 40);
+  CHECK(other == 0);
+  // Under a pose 5 cm off no planted pair is a candidate (what remains is for RANSAC to reject).
+  for (const auto& m : bt::matchFeatures(a, b, settings, bt::MatchGate{shifted, 0.02f, 45.0f}))
+    CHECK(m.first != m.second + 10);
 }

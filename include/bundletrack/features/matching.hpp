@@ -14,6 +14,11 @@ namespace bundletrack {
 
 struct MatchSettings {
   float ratio = 0.8f;  ///< Lowe's ratio test: best distance < ratio * second best, in both directions
+  /// With a gate (a known relative pose), compare only the pairs the gate admits and run the ratio
+  /// test among them (guided matching): a few candidates per keypoint instead of all of them. It
+  /// finds every match the gated exhaustive search finds, and more where a look-alike lies
+  /// outside the gate.
+  bool guided = true;
 };
 
 /// Geometric gate for a pair whose relative pose is already known (DESIGN.md section 3: 2 cm and
@@ -25,12 +30,65 @@ struct MatchGate {
   float max_normal_angle_deg = 45.0f;
 };
 
+/// Distance between descriptor rows a and b (CV_32F rows under NORM_L2, CV_8U rows under NORM_HAMMING).
+inline float descriptorDistance(const cv::Mat& a, const cv::Mat& b, int norm_type) {
+  if (norm_type == cv::NORM_L2) {
+    const float* x = a.ptr<float>();
+    const float* y = b.ptr<float>();
+    float sum = 0.0f;
+    for (int k = 0; k < a.cols; ++k) sum += (x[k] - y[k]) * (x[k] - y[k]);
+    return std::sqrt(sum);
+  }
+  return float(cv::norm(a, b, norm_type));
+}
+
+/// Guided matching under a known relative pose: mutual nearest neighbours with the ratio test in
+/// both directions, among the pairs the gate admits only (a keypoint with one candidate passes
+/// the ratio test). Sorted by the first index.
+inline std::vector<FeatureMatch> matchGuided(const FrameFeatures& first, const FrameFeatures& second,
+                                             const MatchSettings& settings, const MatchGate& gate) {
+  struct Nearest {
+    float best = INFINITY, second = INFINITY;
+    int index = -1;
+    void offer(float distance, int candidate) {
+      if (distance < best) second = best, best = distance, index = candidate;
+      else if (distance < second) second = distance;
+    }
+    bool distinct(float ratio) const { return index >= 0 && best < ratio * second; }
+  };
+  const int n1 = int(first.size()), n2 = int(second.size());
+  std::vector<Nearest> forward(static_cast<std::size_t>(n1)), backward(static_cast<std::size_t>(n2));
+  const float cos_max = std::cos(gate.max_normal_angle_deg * std::numbers::pi_v<float> / 180.0f);
+  const float max_sq = gate.max_distance * gate.max_distance;
+  for (int i = 0; i < n1; ++i) {
+    const Eigen::Vector3f moved = gate.T_second_first * first.points[std::size_t(i)];
+    const Eigen::Vector3f turned = gate.T_second_first.rotation() * first.normals[std::size_t(i)];
+    for (int j = 0; j < n2; ++j) {
+      if ((moved - second.points[std::size_t(j)]).squaredNorm() > max_sq || turned.dot(second.normals[std::size_t(j)]) < cos_max)
+        continue;
+      const float distance = descriptorDistance(first.descriptors.row(i), second.descriptors.row(j), first.norm_type);
+      forward[std::size_t(i)].offer(distance, j);
+      backward[std::size_t(j)].offer(distance, i);
+    }
+  }
+  std::vector<FeatureMatch> matches;
+  for (int i = 0; i < n1; ++i) {
+    const Nearest& f = forward[std::size_t(i)];
+    if (!f.distinct(settings.ratio)) continue;
+    const Nearest& b = backward[std::size_t(f.index)];
+    if (b.index == i && b.distinct(settings.ratio)) matches.push_back({i, f.index});
+  }
+  return matches;
+}
+
 /// Mutual nearest neighbours in descriptor space with the ratio test applied in both directions,
 /// so match(a, b) is match(b, a) with the roles swapped (the original code took the union of the
-/// two directions instead). Sorted by the first index.
+/// two directions instead), then the gate when there is one; with a gate and settings.guided,
+/// matchGuided instead. Sorted by the first index.
 inline std::vector<FeatureMatch> matchFeatures(const FrameFeatures& first, const FrameFeatures& second,
                                                const MatchSettings& settings,
                                                const std::optional<MatchGate>& gate = std::nullopt) {
+  if (gate && settings.guided) return matchGuided(first, second, settings, *gate);
   std::vector<FeatureMatch> matches;
   if (first.size() < 2 || second.size() < 2) return matches;  // no second neighbour for the ratio test
   const cv::BFMatcher matcher(first.norm_type);
