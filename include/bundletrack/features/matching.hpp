@@ -42,22 +42,52 @@ inline float descriptorDistance(const cv::Mat& a, const cv::Mat& b, int norm_typ
   return float(cv::norm(a, b, norm_type));
 }
 
+/// The nearest and second-nearest candidate of one keypoint (index -1: none yet).
+struct TwoNearest {
+  int index = -1;
+  float best = INFINITY, second = INFINITY;
+
+  void offer(float distance, int candidate) {
+    if (distance < best) second = best, best = distance, index = candidate;
+    else if (distance < second) second = distance;
+  }
+  /// Lowe's ratio test; a lone candidate passes.
+  bool distinct(float ratio) const { return index >= 0 && best < ratio * second; }
+};
+
+inline bool admitted(const MatchGate& gate, const FrameFeatures& first, int i, const FrameFeatures& second, int j) {
+  const float cos_max = std::cos(gate.max_normal_angle_deg * std::numbers::pi_v<float> / 180.0f);
+  const Eigen::Vector3f moved = gate.T_second_first * first.points[std::size_t(i)];
+  const Eigen::Vector3f turned = gate.T_second_first.rotation() * first.normals[std::size_t(i)];
+  return (moved - second.points[std::size_t(j)]).norm() <= gate.max_distance &&
+         turned.dot(second.normals[std::size_t(j)]) >= cos_max;
+}
+
+/// Pairs that are each other's distinct nearest neighbour (forward[i]: first's keypoint i among
+/// second's, backward[j]: the other way), and that the gate admits when there is one. Sorted by
+/// the first index. Every matcher (CPU, GPU, guided) ends here.
+inline std::vector<FeatureMatch> mutualMatches(const std::vector<TwoNearest>& forward,
+                                               const std::vector<TwoNearest>& backward, const FrameFeatures& first,
+                                               const FrameFeatures& second, float ratio,
+                                               const std::optional<MatchGate>& gate) {
+  std::vector<FeatureMatch> matches;
+  for (int i = 0; i < int(forward.size()); ++i) {
+    const TwoNearest& f = forward[std::size_t(i)];
+    if (!f.distinct(ratio)) continue;
+    const TwoNearest& b = backward[std::size_t(f.index)];
+    if (b.index != i || !b.distinct(ratio)) continue;
+    if (gate && !admitted(*gate, first, i, second, f.index)) continue;
+    matches.push_back({i, f.index});
+  }
+  return matches;
+}
+
 /// Guided matching under a known relative pose: mutual nearest neighbours with the ratio test in
-/// both directions, among the pairs the gate admits only (a keypoint with one candidate passes
-/// the ratio test). Sorted by the first index.
+/// both directions, among the pairs the gate admits only. Sorted by the first index.
 inline std::vector<FeatureMatch> matchGuided(const FrameFeatures& first, const FrameFeatures& second,
                                              const MatchSettings& settings, const MatchGate& gate) {
-  struct Nearest {
-    float best = INFINITY, second = INFINITY;
-    int index = -1;
-    void offer(float distance, int candidate) {
-      if (distance < best) second = best, best = distance, index = candidate;
-      else if (distance < second) second = distance;
-    }
-    bool distinct(float ratio) const { return index >= 0 && best < ratio * second; }
-  };
   const int n1 = int(first.size()), n2 = int(second.size());
-  std::vector<Nearest> forward(static_cast<std::size_t>(n1)), backward(static_cast<std::size_t>(n2));
+  std::vector<TwoNearest> forward(static_cast<std::size_t>(n1)), backward(static_cast<std::size_t>(n2));
   const float cos_max = std::cos(gate.max_normal_angle_deg * std::numbers::pi_v<float> / 180.0f);
   const float max_sq = gate.max_distance * gate.max_distance;
   for (int i = 0; i < n1; ++i) {
@@ -71,14 +101,7 @@ inline std::vector<FeatureMatch> matchGuided(const FrameFeatures& first, const F
       backward[std::size_t(j)].offer(distance, i);
     }
   }
-  std::vector<FeatureMatch> matches;
-  for (int i = 0; i < n1; ++i) {
-    const Nearest& f = forward[std::size_t(i)];
-    if (!f.distinct(settings.ratio)) continue;
-    const Nearest& b = backward[std::size_t(f.index)];
-    if (b.index == i && b.distinct(settings.ratio)) matches.push_back({i, f.index});
-  }
-  return matches;
+  return mutualMatches(forward, backward, first, second, settings.ratio, std::nullopt);
 }
 
 /// Mutual nearest neighbours in descriptor space with the ratio test applied in both directions,
@@ -89,28 +112,18 @@ inline std::vector<FeatureMatch> matchFeatures(const FrameFeatures& first, const
                                                const MatchSettings& settings,
                                                const std::optional<MatchGate>& gate = std::nullopt) {
   if (gate && settings.guided) return matchGuided(first, second, settings, *gate);
-  std::vector<FeatureMatch> matches;
-  if (first.size() < 2 || second.size() < 2) return matches;  // no second neighbour for the ratio test
+  if (first.size() < 2 || second.size() < 2) return {};  // no second neighbour for the ratio test
   const cv::BFMatcher matcher(first.norm_type);
-  std::vector<std::vector<cv::DMatch>> forward, backward;
-  matcher.knnMatch(first.descriptors, second.descriptors, forward, 2);
-  matcher.knnMatch(second.descriptors, first.descriptors, backward, 2);
-  const auto distinct = [&](const std::vector<cv::DMatch>& knn) {
-    return knn.size() == 2 && knn[0].distance < settings.ratio * knn[1].distance;
+  const auto twoNearest = [&](const cv::Mat& query, const cv::Mat& train) {
+    std::vector<std::vector<cv::DMatch>> knn;
+    matcher.knnMatch(query, train, knn, 2);
+    std::vector<TwoNearest> nearest(knn.size());
+    for (std::size_t k = 0; k < knn.size(); ++k)
+      if (knn[k].size() == 2) nearest[k] = {knn[k][0].trainIdx, knn[k][0].distance, knn[k][1].distance};
+    return nearest;
   };
-  const float cos_max = gate ? std::cos(gate->max_normal_angle_deg * std::numbers::pi_v<float> / 180.0f) : -1.0f;
-  for (int i = 0; i < int(forward.size()); ++i) {
-    if (!distinct(forward[i])) continue;
-    const int j = forward[i][0].trainIdx;
-    if (!distinct(backward[j]) || backward[j][0].trainIdx != i) continue;
-    if (gate) {
-      const Eigen::Vector3f moved = gate->T_second_first * first.points[i];
-      const Eigen::Vector3f turned = gate->T_second_first.rotation() * first.normals[i];
-      if ((moved - second.points[j]).norm() > gate->max_distance || turned.dot(second.normals[j]) < cos_max) continue;
-    }
-    matches.push_back({i, j});
-  }
-  return matches;
+  return mutualMatches(twoNearest(first.descriptors, second.descriptors),
+                       twoNearest(second.descriptors, first.descriptors), first, second, settings.ratio, gate);
 }
 
 }  // namespace bundletrack
