@@ -106,3 +106,26 @@ TEST_CASE("propagated mask under the true pose matches the renderer's mask where
                                             cv::Mat(), camera);
   CHECK(cv::countNonZero(masks.mask(empty, object, f0.T_cam_obj)) == 0);
 }
+
+TEST_CASE("propagated masks refuse a first mask they cannot follow, and use before start") {
+  const bt::PinholeCameraf camera{500.0f, 500.0f, 39.5f, 29.5f};
+  cv::Mat depth(60, 80, CV_32FC1, cv::Scalar(1.0f));
+  depth(cv::Rect(10, 10, 20, 20)).setTo(0.0f);
+  cv::Mat mask(60, 80, CV_8UC1, cv::Scalar(0));
+  const cv::Mat color(60, 80, CV_8UC3, cv::Scalar::all(128));
+  bt::PropagatedMasks masks;
+  const auto problem = [&](const cv::Mat& m) -> std::string {
+    try {
+      masks.start(bt::makeFrame("first", color, depth, m, camera), camera, bt::SE3d(), 4);
+    } catch (const bt::InputError& error) {
+      CHECK(error.source() == "frame first");
+      return error.problem();
+    }
+    return "";
+  };
+  CHECK(problem(mask).find("non-empty mask") != std::string::npos);
+  mask(cv::Rect(12, 12, 10, 10)).setTo(255);  // only where the depth is invalid
+  CHECK(problem(mask).find("no valid depth under the first mask") != std::string::npos);
+  const bt::RgbdFrame later = bt::makeFrame("later", color, depth, cv::Mat(), camera);
+  CHECK_THROWS_AS(masks.mask(later, {}, bt::SE3d()), bt::InputError);
+}

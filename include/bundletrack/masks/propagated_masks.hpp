@@ -59,6 +59,8 @@ class PropagatedMasks {
     hull_ = FirstViewHull(first, camera, T_cam_obj, settings_.hull_dilation_px, settings_.hull_depth_tolerance);
     const cv::Mat seen = first.mask & (first.depth > 0.0f);
     first_area_ = cv::countNonZero(seen);
+    if (first_area_ == 0)
+      throw InputError("frame " + first.name, "no valid depth under the first mask: nothing to propagate it from");
     first_depth_ = float(cv::mean(first.depth, seen)[0]);
     started_ = true;
   }
