@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Regenerates bench/RESULTS.md from a fresh run of the benchmarks (build first; see README).
-# Usage: bash bench/make_results.sh [build-dir]   (about 30 minutes on 2 cores: the 3,000-frame
+# Usage: bash bench/make_results.sh [build-dir]   (about 12 minutes on 2 cores: the 3,000-frame
 # memory run takes half of it, the Open3D peers a third; the peers need python3-open3d)
 set -euo pipefail
 build=${1:-build}

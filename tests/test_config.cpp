@@ -18,7 +18,7 @@ std::filesystem::path writeFile(const TempDir& dir, const std::string& name, con
 
 }  // namespace
 
-TEST_CASE("configuration values land in the settings they name; printing reads back identically") {
+TEST_CASE("configuration values land in the settings they name, and printing reads back identically") {
   TempDir dir("config");
   const auto path = writeFile(dir, "a.yaml",
                               "graph:\n  max_keyframes: 7\n  edge_gate_distance: 0.03\n"

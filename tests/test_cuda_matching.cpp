@@ -1,8 +1,9 @@
 // The GPU descriptor matcher against OpenCV's brute-force matcher and the CPU correspondence
-// source, and the tracker composed with GPU policies against the CPU tracker; skips without a
-// CUDA device.
+// source, and the tracker composed of GPU policies against the CPU tracker; skips without a CUDA
+// device.
 #include <doctest/doctest.h>
 
+#include "bundletrack/cuda/dense_point_to_plane.hpp"
 #include "bundletrack/cuda/matching.hpp"
 #include "bundletrack/cuda/pcg.hpp"
 #include "bundletrack/eval/sequence_score.hpp"
@@ -70,7 +71,7 @@ TEST_CASE("GPU two-nearest search equals OpenCV's brute-force matcher (SIFT, ORB
   checkAgainstOpenCv(bt::OrbFeatures());
 }
 
-TEST_CASE("tracker with GPU PCG and GPU matching tracks as the CPU tracker does") {
+TEST_CASE("tracker composed of GPU policies (PCG, matching, dense term) tracks as the CPU tracker does") {
   if (!bt::cuda::deviceAvailable()) {
     MESSAGE("SKIPPED: no CUDA device");
     return;
@@ -84,7 +85,8 @@ TEST_CASE("tracker with GPU PCG and GPU matching tracks as the CPU tracker does"
   bt::SiftSettings sift;
   sift.matching.guided = false;  // the GPU matcher is exhaustive
   bt::Tracker<bt::DefaultEnergy, bt::PCG, bt::SiftFeatures> cpu(camera, {}, {}, {}, bt::SiftFeatures(sift));
-  bt::Tracker<bt::DefaultEnergy, bt::cuda::PCG, bt::cuda::GpuMatched<bt::SiftFeatures>> gpu(
+  using GpuEnergy = bt::Energy<bt::Term<bt::FeaturePointToPoint, bt::HuberLoss>, bt::Term<bt::cuda::DensePointToPlane, bt::HuberLoss>>;
+  bt::Tracker<GpuEnergy, bt::cuda::PCG, bt::cuda::GpuMatched<bt::SiftFeatures>> gpu(
       camera, {}, {}, {}, bt::cuda::GpuMatched<bt::SiftFeatures>(bt::SiftFeatures(sift), sift.matching));
   std::vector<bt::SE3d> truth, on_cpu, on_gpu;
   for (int i = 0; i < settings.frames; ++i) {

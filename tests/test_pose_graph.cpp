@@ -187,7 +187,7 @@ TEST_CASE("Gauss-Newton brings perturbed poses back to the truth, node 0 fixed")
   }
 }
 
-TEST_CASE("keyframe pool: greedy selection keeps frame 0 and follows the geodesic sums; bounded size") {
+TEST_CASE("keyframe pool: greedy selection keeps frame 0 and follows the geodesic sums, and the pool is bounded") {
   bt::KeyframePool pool(4);
   const Eigen::Vector3d rotations[4] = {{0, 0, 0}, {0.5, 0, 0}, {0, 0, 0.5}, {0, 0, 0.2}};
   for (int k = 0; k < 4; ++k) {

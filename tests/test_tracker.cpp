@@ -79,7 +79,7 @@ TEST_CASE("from the first mask alone: propagated masks track the hand-held box a
   CHECK(propagated.mean_mask_iou >= 0.8);
 }
 
-TEST_CASE("feature-only and dense-only energies compose and track; dense alone holds a textureless can") {
+TEST_CASE("feature-only and dense-only energies compose and track, and dense alone holds a textureless can") {
   synth::SyntheticSequenceSettings settings;
   settings.frames = 30;
   settings.shape = synth::Shape::Cylinder;

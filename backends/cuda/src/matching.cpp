@@ -1,6 +1,7 @@
 #include "bundletrack/cuda/matching.hpp"
 
 #include <cstring>
+#include <mutex>
 #include <stdexcept>
 
 #include "matching_device.hpp"
@@ -8,6 +9,7 @@
 namespace bundletrack::cuda {
 
 struct DescriptorMatcher::Workspace {
+  std::mutex mutex;  // one search at a time uses the device buffers
   detail::MatchBuffers* buffers = detail::createMatchBuffers();
   ~Workspace() { detail::destroyMatchBuffers(buffers); }
 };
@@ -29,6 +31,7 @@ std::vector<TwoNearest> DescriptorMatcher::twoNearest(const cv::Mat& query, cons
   if (query.cols != train.cols || query.type() != train.type())
     throw std::invalid_argument("GPU matcher: query and train descriptors differ in width or type");
   const int queries = query.rows, trains = train.rows;
+  const std::lock_guard lock(workspace_->mutex);
   std::vector<int> index(static_cast<std::size_t>(queries));
   std::vector<float> best(static_cast<std::size_t>(queries)), second(static_cast<std::size_t>(queries));
   if (norm_type == cv::NORM_L2 && query.type() == CV_32F) {

@@ -1,5 +1,6 @@
 #include "bundletrack/cuda/pcg.hpp"
 
+#include <mutex>
 #include <vector>
 
 #include <Eigen/Cholesky>
@@ -9,6 +10,7 @@
 namespace bundletrack::cuda {
 
 struct PCG::Workspace {
+  std::mutex mutex;  // one solve at a time uses the device buffers
   detail::DeviceBuffers* buffers = detail::createBuffers();
   std::vector<float> H, block_inverse, rhs, x;
   ~Workspace() { detail::destroyBuffers(buffers); }
@@ -21,6 +23,7 @@ PCG::PCG() : workspace_(std::make_shared<Workspace>()) {}
 SolveReport PCG::solve(const Eigen::MatrixXd& H, const Eigen::VectorXd& rhs, Eigen::VectorXd& x) const {
   const Eigen::Index n = H.rows(), blocks = n / 6;
   Workspace& w = *workspace_;
+  const std::lock_guard lock(w.mutex);
   w.H.resize(std::size_t(n * n));
   Eigen::Map<Eigen::Matrix<float, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>>(w.H.data(), n, n) = H.cast<float>();
   // Preconditioner blocks as in bundletrack::PCG, factored on the host in double (36 numbers each).

@@ -59,6 +59,16 @@ struct PairSystem {
     ++residuals;
   }
 
+  /// Adds the sums of many addRelative() calls at once: sum w J_i^T J_i, sum w r J_i^T, the
+  /// weighted losses and their count (a GPU backend accumulates these on the device).
+  void addRelativeSums(const Eigen::Matrix<double, 6, 6>& JtWJ, const Eigen::Matrix<double, 6, 1>& JtWr, double cost_sum,
+                       int count) {
+    relative_H_ += JtWJ;
+    relative_b_ += JtWr;
+    cost += cost_sum;
+    residuals += count;
+  }
+
   /// Folds the relative-pose accumulators into H and b; call once after the last addRelative().
   void finish() {
     H.topLeftCorner<6, 6>() += relative_H_;

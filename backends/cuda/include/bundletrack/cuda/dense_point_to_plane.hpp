@@ -1,0 +1,49 @@
+#pragma once
+
+#include <memory>
+#include <type_traits>
+
+#include "bundletrack/residuals/pair_system.hpp"
+
+namespace bundletrack::cuda {
+
+/// The robust losses the GPU kernels evaluate, as plain data across the boundary.
+struct LossParameters {
+  enum Kind { Trivial, Huber, Cauchy, Tukey } kind = Trivial;
+  double parameter = 0.0;  ///< Huber's delta, Cauchy's and Tukey's scale
+};
+
+template <RobustLoss Loss>
+LossParameters lossParameters(const Loss& loss) {
+  if constexpr (std::is_same_v<Loss, TrivialLoss>) return {LossParameters::Trivial, 0.0};
+  else if constexpr (std::is_same_v<Loss, HuberLoss>) return {LossParameters::Huber, loss.delta};
+  else if constexpr (std::is_same_v<Loss, CauchyLoss>) return {LossParameters::Cauchy, loss.scale};
+  else if constexpr (std::is_same_v<Loss, TukeyLoss>) return {LossParameters::Tukey, loss.scale};
+  else static_assert(!sizeof(Loss), "this robust loss has no GPU version (Trivial, Huber, Cauchy, Tukey have)");
+}
+
+/// The dense point-to-plane term (paper eq. 3) on the GPU: the association, gates, residual and
+/// Jacobian of bundletrack::DensePointToPlane, one kernel per direction of an edge, robust weights
+/// and the edge's normal equations accumulated in double on the device. Keyframe grids are
+/// uploaded once and stay on the device while they are in use (the 64 most recently used).
+/// Satisfies Residual, so Energy<..., Term<cuda::DensePointToPlane, HuberLoss>> composes.
+class DensePointToPlane {
+ public:
+  float max_distance = 0.02f;  ///< metres (original code: 2 cm)
+  float max_normal_angle_deg = 45.0f;
+
+  DensePointToPlane();
+
+  template <RobustLoss Loss>
+  void linearise(const PairInput& in, const Loss& loss, double weight, PairSystem& system) const {
+    lineariseWith(in, lossParameters(loss), weight, system);
+  }
+
+ private:
+  void lineariseWith(const PairInput& in, const LossParameters& loss, double weight, PairSystem& system) const;
+
+  struct Workspace;
+  std::shared_ptr<Workspace> workspace_;
+};
+
+}  // namespace bundletrack::cuda

@@ -1,0 +1,35 @@
+#pragma once
+
+// The boundary between host code and the CUDA translation unit: plain data and pointers only.
+
+namespace bundletrack::cuda::detail {
+
+/// A keyframe's dense grid on the device (owned by the .cu side).
+struct DeviceGrid;
+
+/// Copies a grid of width x height points and normals (3 floats each, row-major) and the list of
+/// its surface cells (row-major cell indices) to the device.
+DeviceGrid* uploadGrid(const float* points, const float* normals, int width, int height, const int* cells, int count);
+void releaseGrid(DeviceGrid* grid);
+
+/// One direction s -> t of an edge: rigid maps as row-major 3x4 [R | t] in double, the gates and
+/// the grid camera, and the robust loss.
+struct DirectedPass {
+  double T_t_s[12], T_s_t[12], T_s_inv[12], T_t_inv[12];
+  double cos_max, max_sq;
+  float fx, fy, cx, cy;
+  int loss_kind;
+  double loss_parameter, weight;
+};
+
+/// Device memory the sums of accumulateDense land in (one per caller at a time).
+struct DeviceSums;
+DeviceSums* createSums();
+void releaseSums(DeviceSums* sums);
+
+/// Sums over the surface cells of s associated with t: w J^T J (6x6 row-major, 36), w r J^T (6),
+/// the weighted losses and the count, with J = dr/dd_s (DensePointToPlane's documentation).
+void accumulateDense(DeviceSums& sums, const DeviceGrid& s, const DeviceGrid& t, const DirectedPass& pass,
+                     double JtWJ[36], double JtWr[6], double* cost, int* count);
+
+}  // namespace bundletrack::cuda::detail

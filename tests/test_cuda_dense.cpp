@@ -1,0 +1,70 @@
+// The GPU dense point-to-plane term against its CPU twin on the same keyframe pairs; skips
+// without a CUDA device.
+#include <doctest/doctest.h>
+
+#include "bundletrack/cuda/dense_point_to_plane.hpp"
+#include "bundletrack/cuda/pcg.hpp"
+#include "bundletrack/residuals/dense_point_to_plane.hpp"
+#include "bundletrack/synth/synthetic_sequence.hpp"
+
+namespace bt = bundletrack;
+namespace synth = bundletrack::synth;
+
+static_assert(bt::Residual<bt::cuda::DensePointToPlane>, "the GPU dense term composes like the CPU one");
+
+namespace {
+
+template <typename Loss>
+void compare(const bt::Keyframe& a, const bt::Keyframe& b, const bt::SE3d& T_a, const bt::SE3d& T_b,
+             const bt::PinholeCameraf& grid, const Loss& loss, const bt::cuda::DensePointToPlane& gpu) {
+  const std::vector<bt::FeatureMatch> none;
+  const bt::PairInput input{a, b, T_a, T_b, none, grid};
+  bt::PairSystem on_cpu, on_gpu;
+  bt::DensePointToPlane{}.linearise(input, loss, 0.7, on_cpu);
+  gpu.linearise(input, loss, 0.7, on_gpu);
+  REQUIRE(on_cpu.residuals > 500);
+  // The same residuals up to projections that round the other way at a pixel or gate boundary.
+  CHECK(std::abs(on_gpu.residuals - on_cpu.residuals) <= on_cpu.residuals / 1000 + 1);
+  const double tolerance = on_gpu.residuals == on_cpu.residuals ? 1e-4 : 1e-2;
+  CHECK((on_gpu.H - on_cpu.H).norm() <= tolerance * on_cpu.H.norm());
+  CHECK((on_gpu.b - on_cpu.b).norm() <= tolerance * on_cpu.b.norm());
+  CHECK(on_gpu.cost == doctest::Approx(on_cpu.cost).epsilon(tolerance));
+}
+
+}  // namespace
+
+TEST_CASE("GPU dense point-to-plane term equals the CPU term for every loss, with keyframes kept on the device") {
+  if (!bt::cuda::deviceAvailable()) {
+    MESSAGE("SKIPPED: no CUDA device");
+    return;
+  }
+  synth::SyntheticSequenceSettings settings;
+  settings.frames = 8;
+  const synth::SyntheticScene scene(settings);
+  const auto camera = settings.camera.cast<float>();
+  const int step = 4;
+  std::vector<bt::Keyframe> keyframes;
+  std::vector<bt::SE3d> truth;
+  for (const int i : {0, 7}) {
+    const synth::SyntheticFrame f = scene.frame(i);
+    const bt::RgbdFrame frame = bt::makeFrame(std::to_string(i), f.color, f.depth, f.mask, camera);
+    keyframes.push_back(bt::makeKeyframe(i, frame, frame.mask, {}, f.T_cam_obj, step));
+    truth.push_back(f.T_cam_obj);
+  }
+  // Poses a few millimetres and a degree off the truth, as in a Gauss-Newton iteration.
+  const bt::SE3d nudge = bt::SE3d::exp((Eigen::Matrix<double, 6, 1>() << 0.003, -0.002, 0.004, 0.01, -0.015, 0.005).finished());
+  const bt::PinholeCameraf grid = bt::downsampledCamera(camera, step);
+  const bt::cuda::DensePointToPlane gpu;
+  for (int repeat = 0; repeat < 2; ++repeat) {  // the second round reads the grids kept on the device
+    compare(keyframes[0], keyframes[1], truth[0], nudge * truth[1], grid, bt::HuberLoss{}, gpu);
+    compare(keyframes[0], keyframes[1], truth[0], nudge * truth[1], grid, bt::TrivialLoss{}, gpu);
+    compare(keyframes[0], keyframes[1], truth[0], nudge * truth[1], grid, bt::CauchyLoss{}, gpu);
+    compare(keyframes[0], keyframes[1], truth[0], nudge * truth[1], grid, bt::TukeyLoss{}, gpu);
+  }
+  // A keyframe whose grid changed under the same id is uploaded again, not read stale.
+  bt::Keyframe moved = keyframes[1];
+  moved.points = keyframes[1].points.clone();
+  moved.points += cv::Scalar(0.001, 0.0, 0.0);
+  bt::indexSurface(moved);
+  compare(keyframes[0], moved, truth[0], nudge * truth[1], grid, bt::HuberLoss{}, gpu);
+}
