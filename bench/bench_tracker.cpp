@@ -1,9 +1,11 @@
-// bench_tracker [--sequence DIR ...] [--frames N] [--memory-every N]
+// bench_tracker [--sequence DIR ...] [--frames N] [--memory-every N] [--gpu]
 // Runs the default tracker on each sequence (or on a synthetic one rendered in memory) and prints,
 // per stage, the median and 90th percentile of the milliseconds per frame, the share of the
 // median frame, and frames per second (tracking only, and with reading + preprocessing).
 // --memory-every N also prints, every N frames, the keyframes in the pool and the process's
 // resident and peak resident memory (Linux /proc/self/status).
+// --gpu (builds with BUNDLETRACK_CUDA) also runs the tracker composed of the GPU policies on the
+// same frames and prints both per-stage medians side by side with the GPU/CPU ratio.
 #include <algorithm>
 #include <cstdio>
 #include <fstream>
@@ -13,6 +15,11 @@
 #include "bundletrack/io/ycbineoat_sequence.hpp"
 #include "bundletrack/synth/synthetic_sequence.hpp"
 #include "bundletrack/tracker.hpp"
+#ifdef BUNDLETRACK_HAS_CUDA
+#include "bundletrack/cuda/dense_point_to_plane.hpp"
+#include "bundletrack/cuda/matching.hpp"
+#include "bundletrack/cuda/pcg.hpp"
+#endif
 
 namespace bt = bundletrack;
 
@@ -59,9 +66,8 @@ std::pair<double, double> residentMemoryMiB() {
   return {rss, peak};
 }
 
-template <typename FrameAt>
-Stages track(const bt::PinholeCameraf& camera, std::size_t frames, int memory_every, FrameAt&& frame_at) {
-  bt::DefaultTracker tracker(camera);
+template <typename Tracker, typename FrameAt>
+Stages track(Tracker tracker, std::size_t frames, int memory_every, FrameAt&& frame_at) {
   Stages stages;
   if (memory_every > 0) std::printf("%8s %10s %12s %13s %6s\n", "frame", "keyframes", "resident MiB", "peak MiB", "lost");
   int lost = 0;
@@ -81,38 +87,94 @@ Stages track(const bt::PinholeCameraf& camera, std::size_t frames, int memory_ev
   return stages;
 }
 
+/// Per-stage medians of two runs on the same frames, and their ratio.
+void compare(const Stages& cpu, const Stages& gpu) {
+  std::printf("\n%-10s %12s %12s %10s\n", "stage", "CPU ms", "GPU ms", "GPU/CPU");
+  const std::pair<const char*, std::pair<const std::vector<double>*, const std::vector<double>*>> rows[] = {
+      {"mask", {&cpu.mask, &gpu.mask}},       {"features", {&cpu.features, &gpu.features}},
+      {"matching", {&cpu.matching, &gpu.matching}}, {"ransac", {&cpu.ransac, &gpu.ransac}},
+      {"graph", {&cpu.graph, &gpu.graph}},    {"solve", {&cpu.solve, &gpu.solve}},
+      {"total", {&cpu.total, &gpu.total}}};
+  for (const auto& [label, values] : rows) {
+    const double c = percentile(*values.first, 0.5), g = percentile(*values.second, 0.5);
+    std::printf("%-10s %12.2f %12.2f %10.2f\n", label, c, g, c > 0.0 ? g / c : 0.0);
+  }
+}
+
+struct Options {
+  std::vector<std::string> sequences;
+  int frames = 150, memory_every = 0;
+  bool gpu = false;
+};
+
+/// The default tracker on the frames, and with --gpu the GPU-composed one as well.
+template <typename FrameAt>
+void run(const std::string& name, const bt::PinholeCameraf& camera, std::size_t frames, const Options& options,
+         FrameAt&& frame_at) {
+  const Stages cpu = track(bt::DefaultTracker(camera), frames, options.memory_every, frame_at);
+  report(name, cpu);
+  if (!options.gpu) return;
+#ifdef BUNDLETRACK_HAS_CUDA
+  using GpuEnergy = bt::Energy<bt::Term<bt::FeaturePointToPoint, bt::HuberLoss>, bt::Term<bt::cuda::DensePointToPlane, bt::HuberLoss>>;
+  using GpuTracker = bt::Tracker<GpuEnergy, bt::cuda::PCG, bt::cuda::GpuMatched<bt::SiftFeatures>>;
+  const Stages gpu = track(GpuTracker(camera), frames, 0, frame_at);
+  report(name + " (GPU policies: cuda::PCG, cuda::GpuMatched<SiftFeatures>, cuda::DensePointToPlane)", gpu);
+  compare(cpu, gpu);
+#endif
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
-  std::vector<std::string> sequences;
-  int frames = 150, memory_every = 0;
-  for (int i = 1; i + 1 < argc; i += 2) {
+  Options options;
+  const char* const usage = "usage: bench_tracker [--sequence DIR ...] [--frames N] [--memory-every N] [--gpu]\n";
+  for (int i = 1; i < argc; ++i) {
     const std::string arg = argv[i];
-    if (arg == "--sequence") sequences.emplace_back(argv[i + 1]);
-    else if (arg == "--frames") frames = std::atoi(argv[i + 1]);
-    else if (arg == "--memory-every") memory_every = std::atoi(argv[i + 1]);
+    if (arg == "--gpu") {
+      options.gpu = true;
+      continue;
+    }
+    if (i + 1 >= argc) {
+      std::fprintf(stderr, "%s needs a value\n%s", arg.c_str(), usage);
+      return 2;
+    }
+    if (arg == "--sequence") options.sequences.emplace_back(argv[++i]);
+    else if (arg == "--frames") options.frames = std::atoi(argv[++i]);
+    else if (arg == "--memory-every") options.memory_every = std::atoi(argv[++i]);
     else {
-      std::fprintf(stderr, "usage: bench_tracker [--sequence DIR ...] [--frames N] [--memory-every N]\n");
+      std::fprintf(stderr, "unknown option '%s'\n%s", arg.c_str(), usage);
       return 2;
     }
   }
+#ifdef BUNDLETRACK_HAS_CUDA
+  if (options.gpu && !bt::cuda::deviceAvailable()) {
+    std::fprintf(stderr, "error: --gpu: no CUDA device available\n");
+    return 1;
+  }
+#else
+  if (options.gpu) {
+    std::fprintf(stderr, "error: --gpu: this build has no CUDA backend (configure with BUNDLETRACK_CUDA=ON)\n");
+    return 1;
+  }
+#endif
+  const int frames = options.frames;
   try {
-    if (sequences.empty()) {
+    if (options.sequences.empty()) {
       bt::synth::SyntheticSequenceSettings settings;
       settings.frames = frames;
       const bt::synth::SyntheticScene scene(settings);
       const auto camera = settings.camera.cast<float>();
-      report("synthetic hand-held box (rendering counted as reading)",
-             track(camera, std::size_t(frames), memory_every, [&](std::size_t i) {
-               const auto f = scene.frame(int(i));
-               return std::pair(bt::makeFrame(std::to_string(i), f.color, f.depth, f.mask, camera), f.T_cam_obj);
-             }));
+      run("synthetic hand-held box (rendering counted as reading)", camera, std::size_t(frames), options,
+          [&](std::size_t i) {
+            const auto f = scene.frame(int(i));
+            return std::pair(bt::makeFrame(std::to_string(i), f.color, f.depth, f.mask, camera), f.T_cam_obj);
+          });
     }
-    for (const auto& dir : sequences) {
+    for (const auto& dir : options.sequences) {
       const bt::io::YcbineoatSequence sequence(dir);
-      report(dir, track(sequence.camera().cast<float>(), sequence.size(), memory_every, [&](std::size_t i) {
-               return std::pair(sequence.frame(i), sequence.hasGroundTruth() ? sequence.groundTruthPose(i) : bt::SE3d());
-             }));
+      run(dir, sequence.camera().cast<float>(), sequence.size(), options, [&](std::size_t i) {
+        return std::pair(sequence.frame(i), sequence.hasGroundTruth() ? sequence.groundTruthPose(i) : bt::SE3d());
+      });
     }
   } catch (const std::exception& error) {
     std::fprintf(stderr, "error: %s\n", error.what());

@@ -86,6 +86,19 @@ depth=$("$build/bin/bench_depth_processing" --benchmark_format=csv 2>/dev/null)
   "$build/bin/bench_tracker" --frames 150
   [ ${#args[@]} -gt 0 ] && "$build/bin/bench_tracker" "${args[@]}"
   echo '```'
+  if command -v nvidia-smi > /dev/null && nvidia-smi -L > /dev/null 2>&1 && "$build/bin/bench_tracker" --gpu --frames 2 > /dev/null 2>&1; then
+    echo
+    echo "## CPU and GPU policies side by side (bench_tracker --gpu)"
+    echo
+    echo "GPU: $(nvidia-smi --query-gpu=name --format=csv,noheader | head -1). Default tracker against"
+    echo "Tracker<FeaturePointToPoint + cuda::DensePointToPlane, cuda::PCG, cuda::GpuMatched<SiftFeatures>>"
+    echo "on the same frames, same run; medians in ms per frame (absolute: this is the GPU machine)."
+    echo
+    echo '```'
+    "$build/bin/bench_tracker" --gpu --frames 150
+    [ ${#args[@]} -gt 0 ] && "$build/bin/bench_tracker" --gpu "${args[@]}"
+    echo '```'
+  fi
   echo
   echo "## Memory over a 3,000-frame synthetic run (bench_tracker --frames 3000 --memory-every 250)"
   echo

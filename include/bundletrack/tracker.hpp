@@ -151,7 +151,10 @@ class Tracker {
       result.timings.mask += watch.lap();
       if (cv::countNonZero(masked.mask) == 0) return lost(result, total);  // not where the pose says
       const std::vector<int> kept = keepFeaturesInside(features, masked.mask);
-      std::erase_if(previous_inliers, [&](FeatureMatch& m) { return (m.second = kept[std::size_t(m.second)]) < 0; });
+      std::vector<FeatureMatch> remapped;
+      for (const FeatureMatch& m : previous_inliers)
+        if (const int second = kept[std::size_t(m.second)]; second >= 0) remapped.push_back({m.first, second});
+      previous_inliers = std::move(remapped);
     }
 
     // Pose graph over the selected keyframes and the current frame (paper IV-C, IV-D).
