@@ -97,6 +97,8 @@ inline std::vector<ConfigParameter> configParameters(Config& c) {
       {"graph", "min_agreement", &t.min_agreement, 0.0, 1.0, "", "fraction of overlapping points on a keyframe's surface to accept the graph's pose"},
       {"graph", "agreement_distance", &t.agreement_distance, 0.0, 1.0, "m", "on the surface: within this distance"},
       {"graph", "recovery_min_inliers", &t.recovery_min_inliers, 3, 100000, "", "RANSAC inliers needed to restart after lost frames"},
+      {"graph", "recovery_min_keypoints", &t.recovery_min_keypoints, 0, 100000, "", "fewer keypoints: a lost frame is re-acquired by the surface alone"},
+      {"graph", "recovery_min_agreement", &t.recovery_min_agreement, 0.0, 1.0, "", "agreement such a re-acquisition needs"},
       {"graph", "gauss_newton_iterations", &t.gauss_newton.iterations, 0, 1000, "", "paper IV-D, original code: 7"},
       {"masks", "search_margin_px", &m.search_margin_px, 0, 10000, "px", "propagated: keypoints are searched this far around the last pose's silhouette"},
       {"masks", "growth_px", &m.growth_px, 0, 10000, "px", "propagated: the mask reaches this far beyond the rendered silhouette"},
