@@ -19,6 +19,7 @@
 #include "bundletrack/cuda/dense_point_to_plane.hpp"
 #include "bundletrack/cuda/matching.hpp"
 #include "bundletrack/cuda/pcg.hpp"
+#include "bundletrack/cuda/ransac.hpp"
 #endif
 
 namespace bt = bundletrack;
@@ -116,9 +117,10 @@ void run(const std::string& name, const bt::PinholeCameraf& camera, std::size_t 
   if (!options.gpu) return;
 #ifdef BUNDLETRACK_HAS_CUDA
   using GpuEnergy = bt::Energy<bt::Term<bt::FeaturePointToPoint, bt::HuberLoss>, bt::Term<bt::cuda::DensePointToPlane, bt::HuberLoss>>;
-  using GpuTracker = bt::Tracker<GpuEnergy, bt::cuda::PCG, bt::cuda::GpuMatched<bt::SiftFeatures>>;
+  using GpuTracker =
+      bt::Tracker<GpuEnergy, bt::cuda::PCG, bt::cuda::GpuMatched<bt::SiftFeatures>, bt::GivenMasks, bt::cuda::Ransac>;
   const Stages gpu = track(GpuTracker(camera), frames, 0, frame_at);
-  report(name + " (GPU policies: cuda::PCG, cuda::GpuMatched<SiftFeatures>, cuda::DensePointToPlane)", gpu);
+  report(name + " (GPU policies: cuda::PCG, cuda::GpuMatched<SiftFeatures>, cuda::DensePointToPlane, cuda::Ransac)", gpu);
   compare(cpu, gpu);
 #endif
 }

@@ -91,7 +91,8 @@ depth=$("$build/bin/bench_depth_processing" --benchmark_format=csv 2>/dev/null)
     echo "## CPU and GPU policies side by side (bench_tracker --gpu)"
     echo
     echo "GPU: $(nvidia-smi --query-gpu=name --format=csv,noheader | head -1). Default tracker against"
-    echo "Tracker<FeaturePointToPoint + cuda::DensePointToPlane, cuda::PCG, cuda::GpuMatched<SiftFeatures>>"
+    echo "Tracker<FeaturePointToPoint + cuda::DensePointToPlane, cuda::PCG, cuda::GpuMatched<SiftFeatures>,"
+    echo "GivenMasks, cuda::Ransac>"
     echo "on the same frames, same run; medians in ms per frame (absolute: this is the GPU machine)."
     echo
     echo '```'

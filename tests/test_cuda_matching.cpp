@@ -6,6 +6,7 @@
 #include "bundletrack/cuda/dense_point_to_plane.hpp"
 #include "bundletrack/cuda/matching.hpp"
 #include "bundletrack/cuda/pcg.hpp"
+#include "bundletrack/cuda/ransac.hpp"
 #include "bundletrack/eval/sequence_score.hpp"
 #include "bundletrack/synth/synthetic_sequence.hpp"
 #include "bundletrack/tracker.hpp"
@@ -71,7 +72,7 @@ TEST_CASE("GPU two-nearest search equals OpenCV's brute-force matcher (SIFT, ORB
   checkAgainstOpenCv(bt::OrbFeatures());
 }
 
-TEST_CASE("tracker composed of GPU policies (PCG, matching, dense term) tracks as the CPU tracker does") {
+TEST_CASE("tracker composed of GPU policies (PCG, matching, dense term, RANSAC) tracks as the CPU tracker does") {
   if (!bt::cuda::deviceAvailable()) {
     MESSAGE("SKIPPED: no CUDA device");
     return;
@@ -86,7 +87,7 @@ TEST_CASE("tracker composed of GPU policies (PCG, matching, dense term) tracks a
   sift.matching.guided = false;  // the GPU matcher is exhaustive
   bt::Tracker<bt::DefaultEnergy, bt::PCG, bt::SiftFeatures> cpu(camera, {}, {}, {}, bt::SiftFeatures(sift));
   using GpuEnergy = bt::Energy<bt::Term<bt::FeaturePointToPoint, bt::HuberLoss>, bt::Term<bt::cuda::DensePointToPlane, bt::HuberLoss>>;
-  bt::Tracker<GpuEnergy, bt::cuda::PCG, bt::cuda::GpuMatched<bt::SiftFeatures>> gpu(
+  bt::Tracker<GpuEnergy, bt::cuda::PCG, bt::cuda::GpuMatched<bt::SiftFeatures>, bt::GivenMasks, bt::cuda::Ransac> gpu(
       camera, {}, {}, {}, bt::cuda::GpuMatched<bt::SiftFeatures>(bt::SiftFeatures(sift), sift.matching));
   std::vector<bt::SE3d> truth, on_cpu, on_gpu;
   for (int i = 0; i < settings.frames; ++i) {

@@ -63,12 +63,14 @@ struct TrackerSettings {
 using DefaultEnergy = Energy<Term<FeaturePointToPoint, HuberLoss>, Term<DensePointToPlane, HuberLoss>>;
 
 /// BundleTrack (paper IV) composed at compile time from its policies: the pose-graph energy, the
-/// linear solver of the Gauss-Newton steps, the correspondence source and the mask source.
+/// linear solver of the Gauss-Newton steps, the correspondence source, the mask source and the
+/// robust registration (RANSAC) of the coarse step.
 /// Feed frames in order: initialize() with the first, then track() each one; every call returns
 /// the pose of that frame, its status, the mask used and per-stage timings, and never changes an
 /// earlier answer. With a PropagatedMaskSource only the first frame's mask is read.
 template <PoseGraphEnergy EnergyT = DefaultEnergy, LinearSolver Solver = PCG,
-          CorrespondenceSource Correspondences = SiftFeatures, MaskSource Masks = GivenMasks>
+          CorrespondenceSource Correspondences = SiftFeatures, MaskSource Masks = GivenMasks,
+          FeatureRegistration Registration = Ransac>
 class Tracker {
  public:
   using Settings = TrackerSettings;
@@ -379,7 +381,7 @@ class Tracker {
   Solver solver_;
   Correspondences correspondences_;
   Masks masks_;
-  Ransac ransac_;
+  Registration ransac_;
   KeyframePool pool_;
   std::map<std::pair<int, int>, std::vector<FeatureMatch>> cache_;
   std::optional<Previous> previous_;

@@ -2,8 +2,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <concepts>
 #include <cstdint>
 #include <numbers>
+#include <utility>
 #include <vector>
 
 #include <opencv2/core.hpp>
@@ -46,14 +48,84 @@ inline std::uint64_t splitmix64(std::uint64_t x) {
 
 }  // namespace detail
 
+/// The matched points of one RANSAC problem, side by side (pair k is match k).
+struct MatchedPoints {
+  std::vector<Eigen::Vector3f> first, second, first_normals, second_normals;
+
+  MatchedPoints(const FrameFeatures& a, const FrameFeatures& b, const std::vector<FeatureMatch>& matches) {
+    for (const FeatureMatch& m : matches) {
+      first.push_back(a.points[std::size_t(m.first)]);
+      second.push_back(b.points[std::size_t(m.second)]);
+      first_normals.push_back(a.normals[std::size_t(m.first)]);
+      second_normals.push_back(b.normals[std::size_t(m.second)]);
+    }
+  }
+  std::size_t size() const { return first.size(); }
+};
+
+/// Paper IV-B's inlier test: the moved point within inlier_distance and the moved normal within
+/// inlier_normal_angle_deg of its match.
+struct InlierGate {
+  float max_squared_distance;
+  float cos_max_angle;
+
+  explicit InlierGate(const RansacSettings& s)
+      : max_squared_distance(s.inlier_distance * s.inlier_distance),
+        cos_max_angle(std::cos(s.inlier_normal_angle_deg * std::numbers::pi_v<float> / 180.0f)) {}
+
+  bool admits(const MatchedPoints& pairs, std::size_t k, const SE3f& T, const Eigen::Matrix3f& R) const {
+    return (T * pairs.first[k] - pairs.second[k]).squaredNorm() < max_squared_distance &&
+           (R * pairs.first_normals[k]).dot(pairs.second_normals[k]) > cos_max_angle;
+  }
+};
+
+/// Counts the inliers of a batch of hypotheses on the CPU (in parallel when asked). The part of
+/// RANSAC a backend may run elsewhere: prepare() sees the problem once, count() every batch;
+/// counts[h] = 0 where valid[h] is false.
+class CpuInlierCounter {
+ public:
+  explicit CpuInlierCounter(bool parallel = true) : parallel_(parallel) {}
+
+  void prepare(const MatchedPoints&) {}
+
+  void count(const MatchedPoints& pairs, const std::vector<SE3f>& hypotheses, const std::vector<char>& valid,
+             const InlierGate& gate, std::vector<int>& counts) const {
+    const auto body = [&](const cv::Range& range) {
+      for (int h = range.start; h < range.end; ++h) {
+        counts[std::size_t(h)] = 0;
+        if (!valid[std::size_t(h)]) continue;
+        const SE3f& T = hypotheses[std::size_t(h)];
+        const Eigen::Matrix3f R = T.rotationMatrix();
+        for (std::size_t k = 0; k < pairs.size(); ++k) counts[std::size_t(h)] += gate.admits(pairs, k, T, R);
+      }
+    };
+    const cv::Range all(0, int(hypotheses.size()));
+    if (parallel_) cv::parallel_for_(all, body);
+    else body(all);
+  }
+
+ private:
+  bool parallel_;
+};
+
+template <typename T>
+concept InlierCounter = requires(T& counter, const MatchedPoints& pairs, const std::vector<SE3f>& hypotheses,
+                                 const std::vector<char>& valid, const InlierGate& gate, std::vector<int>& counts) {
+  counter.prepare(pairs);
+  counter.count(pairs, hypotheses, valid, gate, counts);
+};
+
 /// RANSAC over 3-D feature matches (paper IV-B): 3-point samples, closed-form fit (kabsch), a match
 /// is an inlier when the moved point lies within inlier_distance AND the moved normal within
 /// inlier_normal_angle_deg. The trial count adapts to the best inlier ratio w found so far,
 /// N = log(1 - confidence) / log(1 - w^3), capped at max_trials; ties go to the earliest trial, so
-/// the result is deterministic. The winner is refitted on its inliers while the set grows.
-class Ransac {
+/// the result is deterministic whatever counts the inliers. The winner is refitted on its inliers
+/// while the set grows.
+template <InlierCounter Counter>
+class BasicRansac {
  public:
-  explicit Ransac(RansacSettings settings = {}) : settings_(settings) {}
+  explicit BasicRansac(RansacSettings settings = {}, Counter counter = Counter())
+      : settings_(settings), counter_(std::move(counter)) {}
   const RansacSettings& settings() const { return settings_; }
 
   RansacResult estimate(const FrameFeatures& first, const FrameFeatures& second,
@@ -61,28 +133,33 @@ class Ransac {
     RansacResult result;
     result.matches = matches.size();
     if (matches.size() < 3) return result;
+    const MatchedPoints pairs(first, second, matches);
+    const InlierGate gate(settings_);
+    counter_.prepare(pairs);
     const int n = int(matches.size());
-    std::vector<int> scores(std::size_t(settings_.batch));
-    std::vector<SE3d> hypotheses(std::size_t(settings_.batch));
+    const std::size_t batch = std::size_t(settings_.batch);
+    std::vector<int> scores(batch);
+    std::vector<SE3f> hypotheses(batch);
+    std::vector<SE3d> fits(batch);
+    std::vector<char> valid(batch);
     int best_score = 0, needed = settings_.max_trials;
     SE3d best;
     for (int start = 0; start < std::min(needed, settings_.max_trials); start += settings_.batch) {
       const int count = std::min(settings_.batch, settings_.max_trials - start);
-      const auto score_trials = [&](const cv::Range& range) {
-        for (int b = range.start; b < range.end; ++b) {
-          scores[b] = 0;
-          int sample[3];
-          if (!drawSample(std::uint64_t(start + b), n, first, second, matches, sample)) continue;
-          hypotheses[b] = kabsch(3, [&](std::size_t k) { return pairOf(first, second, matches[sample[k]]); });
-          scores[b] = countInliers(first, second, matches, hypotheses[b], nullptr);
-        }
-      };
-      if (settings_.parallel) cv::parallel_for_(cv::Range(0, count), score_trials);
-      else score_trials(cv::Range(0, count));
+      hypotheses.resize(std::size_t(count)), fits.resize(std::size_t(count)), valid.resize(std::size_t(count));
+      scores.resize(std::size_t(count));
       for (int b = 0; b < count; ++b) {
-        if (scores[b] <= best_score) continue;
-        best_score = scores[b];
-        best = hypotheses[b];
+        int sample[3];
+        valid[std::size_t(b)] = drawSample(std::uint64_t(start + b), n, pairs, sample);
+        if (!valid[std::size_t(b)]) continue;
+        fits[std::size_t(b)] = kabsch(3, [&](std::size_t k) { return pairOf(pairs, sample[k]); });
+        hypotheses[std::size_t(b)] = fits[std::size_t(b)].cast<float>();
+      }
+      counter_.count(pairs, hypotheses, valid, gate, scores);
+      for (int b = 0; b < count; ++b) {
+        if (scores[std::size_t(b)] <= best_score) continue;
+        best_score = scores[std::size_t(b)];
+        best = fits[std::size_t(b)];
         const double w = double(best_score) / n;
         needed = w >= 1.0 ? 0 : int(std::ceil(std::log(1.0 - settings_.confidence) / std::log(1.0 - w * w * w)));
       }
@@ -91,12 +168,10 @@ class Ransac {
     if (best_score < 3) return result;
     // Least-squares refit on the consensus set, repeated while the set changes and does not shrink;
     // the result is always the refit of the reported inliers.
-    std::vector<int> inliers;
-    countInliers(first, second, matches, best, &inliers);
+    std::vector<int> inliers = inliersOf(pairs, gate, best);
     for (int refit = 0; refit < 5; ++refit) {
-      best = kabsch(inliers.size(), [&](std::size_t k) { return pairOf(first, second, matches[inliers[k]]); });
-      std::vector<int> next;
-      countInliers(first, second, matches, best, &next);
+      best = kabsch(inliers.size(), [&](std::size_t k) { return pairOf(pairs, inliers[k]); });
+      std::vector<int> next = inliersOf(pairs, gate, best);
       if (next.size() < inliers.size() || next == inliers) break;
       inliers = std::move(next);
     }
@@ -106,14 +181,20 @@ class Ransac {
   }
 
  private:
-  static std::pair<const Eigen::Vector3f&, const Eigen::Vector3f&> pairOf(const FrameFeatures& first,
-                                                                        const FrameFeatures& second,
-                                                                        const FeatureMatch& m) {
-    return {first.points[m.first], second.points[m.second]};
+  static std::pair<const Eigen::Vector3f&, const Eigen::Vector3f&> pairOf(const MatchedPoints& pairs, int k) {
+    return {pairs.first[std::size_t(k)], pairs.second[std::size_t(k)]};
   }
 
-  bool drawSample(std::uint64_t trial, int n, const FrameFeatures& first, const FrameFeatures& second,
-                  const std::vector<FeatureMatch>& matches, int sample[3]) const {
+  static std::vector<int> inliersOf(const MatchedPoints& pairs, const InlierGate& gate, const SE3d& T) {
+    const SE3f Tf = T.cast<float>();
+    const Eigen::Matrix3f R = Tf.rotationMatrix();
+    std::vector<int> inliers;
+    for (std::size_t k = 0; k < pairs.size(); ++k)
+      if (gate.admits(pairs, k, Tf, R)) inliers.push_back(int(k));
+    return inliers;
+  }
+
+  bool drawSample(std::uint64_t trial, int n, const MatchedPoints& pairs, int sample[3]) const {
     std::uint64_t state = detail::splitmix64(settings_.seed ^ detail::splitmix64(trial));
     for (int k = 0; k < 3; ++k) {
       state = detail::splitmix64(state);
@@ -121,11 +202,8 @@ class Ransac {
     }
     if (sample[0] == sample[1] || sample[0] == sample[2] || sample[1] == sample[2]) return false;
     // Reject near-collinear samples in either frame: the smallest triangle height must exceed the spread.
-    for (const FrameFeatures* f : {&first, &second}) {
-      const bool is_first = f == &first;
-      const auto point = [&](int k) -> const Eigen::Vector3f& {
-        return is_first ? f->points[matches[sample[k]].first] : f->points[matches[sample[k]].second];
-      };
+    for (const std::vector<Eigen::Vector3f>* points : {&pairs.first, &pairs.second}) {
+      const auto point = [&](int k) -> const Eigen::Vector3f& { return (*points)[std::size_t(sample[k])]; };
       const Eigen::Vector3f ab = point(1) - point(0), ac = point(2) - point(0), bc = point(2) - point(1);
       const float longest = std::max({ab.norm(), ac.norm(), bc.norm()});
       if (longest <= 0.0f || ab.cross(ac).norm() / longest < settings_.min_sample_spread) return false;
@@ -133,24 +211,23 @@ class Ransac {
     return true;
   }
 
-  int countInliers(const FrameFeatures& first, const FrameFeatures& second, const std::vector<FeatureMatch>& matches,
-                   const SE3d& T, std::vector<int>* inliers) const {
-    const SE3f Tf = T.cast<float>();
-    const Eigen::Matrix3f R = Tf.rotationMatrix();
-    const float max_sq = settings_.inlier_distance * settings_.inlier_distance;
-    const float cos_max = std::cos(settings_.inlier_normal_angle_deg * std::numbers::pi_v<float> / 180.0f);
-    int count = 0;
-    for (int k = 0; k < int(matches.size()); ++k) {
-      const auto& m = matches[k];
-      if ((Tf * first.points[m.first] - second.points[m.second]).squaredNorm() >= max_sq) continue;
-      if ((R * first.normals[m.first]).dot(second.normals[m.second]) <= cos_max) continue;
-      ++count;
-      if (inliers) inliers->push_back(k);
-    }
-    return count;
-  }
-
   RansacSettings settings_;
+  mutable Counter counter_;  // a backend may keep device buffers between calls
 };
+
+/// RANSAC with the inliers counted on the CPU (in parallel unless settings.parallel is false).
+class Ransac : public BasicRansac<CpuInlierCounter> {
+ public:
+  explicit Ransac(RansacSettings settings = {}) : BasicRansac(settings, CpuInlierCounter(settings.parallel)) {}
+};
+
+/// What the tracker asks of its robust registration (Ransac, cuda::Ransac): built from the
+/// RANSAC settings, it estimates the pose between two frames' features from their matches.
+template <typename T>
+concept FeatureRegistration =
+    std::constructible_from<T, RansacSettings> &&
+    requires(const T& registration, const FrameFeatures& features, const std::vector<FeatureMatch>& matches) {
+      { registration.estimate(features, features, matches) } -> std::same_as<RansacResult>;
+    };
 
 }  // namespace bundletrack

@@ -1,0 +1,94 @@
+#include <cuda_runtime.h>
+
+#include <stdexcept>
+#include <string>
+
+#include "ransac_device.hpp"
+
+namespace bundletrack::cuda::detail {
+
+namespace {
+
+constexpr int kThreads = 128;
+
+void check(cudaError_t status, const char* what) {
+  if (status != cudaSuccess) throw std::runtime_error(std::string("CUDA ") + what + ": " + cudaGetErrorString(status));
+}
+
+/// One block per hypothesis: its threads test the pairs in strides and sum their counts.
+__global__ void countKernel(const float* pairs, int n, const float* hypotheses, const unsigned char* valid,
+                            float max_squared_distance, float cos_max_angle, int* counts) {
+  __shared__ int partial[kThreads];
+  const int h = blockIdx.x;
+  int inliers = 0;
+  if (valid[h]) {
+    const float* T = hypotheses + 12 * h;
+    for (int k = threadIdx.x; k < n; k += blockDim.x) {
+      const float* pair = pairs + 12 * k;
+      float distance = 0.0f, cosine = 0.0f;
+      for (int r = 0; r < 3; ++r) {
+        const float moved = T[4 * r] * pair[0] + T[4 * r + 1] * pair[1] + T[4 * r + 2] * pair[2] + T[4 * r + 3];
+        const float turned = T[4 * r] * pair[6] + T[4 * r + 1] * pair[7] + T[4 * r + 2] * pair[8];
+        distance += (moved - pair[3 + r]) * (moved - pair[3 + r]);
+        cosine += turned * pair[9 + r];
+      }
+      inliers += distance < max_squared_distance && cosine > cos_max_angle;
+    }
+  }
+  partial[threadIdx.x] = inliers;
+  __syncthreads();
+  for (int stride = blockDim.x / 2; stride > 0; stride /= 2) {
+    if (threadIdx.x < stride) partial[threadIdx.x] += partial[threadIdx.x + stride];
+    __syncthreads();
+  }
+  if (threadIdx.x == 0) counts[h] = partial[0];
+}
+
+template <typename T>
+void grow(T*& buffer, int& capacity, int count) {
+  if (count <= capacity) return;
+  if (buffer) check(cudaFree(buffer), "free");
+  check(cudaMalloc(&buffer, std::size_t(count) * sizeof(T)), "malloc");
+  capacity = count;
+}
+
+}  // namespace
+
+struct RansacBuffers {
+  float* pairs = nullptr;
+  float* hypotheses = nullptr;
+  unsigned char* valid = nullptr;
+  int* counts = nullptr;
+  int pair_floats = 0, hypothesis_floats = 0, valid_bytes = 0, count_ints = 0, n = 0;
+
+  ~RansacBuffers() {
+    for (void* p : {static_cast<void*>(pairs), static_cast<void*>(hypotheses), static_cast<void*>(valid),
+                    static_cast<void*>(counts)})
+      if (p) cudaFree(p);
+  }
+};
+
+RansacBuffers* createRansacBuffers() { return new RansacBuffers; }
+void destroyRansacBuffers(RansacBuffers* buffers) { delete buffers; }
+
+void uploadPairs(RansacBuffers& b, const float* pairs, int n) {
+  grow(b.pairs, b.pair_floats, 12 * n);
+  if (n > 0) check(cudaMemcpy(b.pairs, pairs, std::size_t(12 * n) * sizeof(float), cudaMemcpyHostToDevice), "copy pairs");
+  b.n = n;
+}
+
+void countInliers(RansacBuffers& b, const float* hypotheses, const unsigned char* valid, int count,
+                  float max_squared_distance, float cos_max_angle, int* counts) {
+  if (count <= 0) return;
+  grow(b.hypotheses, b.hypothesis_floats, 12 * count);
+  grow(b.valid, b.valid_bytes, count);
+  grow(b.counts, b.count_ints, count);
+  check(cudaMemcpy(b.hypotheses, hypotheses, std::size_t(12 * count) * sizeof(float), cudaMemcpyHostToDevice),
+        "copy hypotheses");
+  check(cudaMemcpy(b.valid, valid, std::size_t(count), cudaMemcpyHostToDevice), "copy validity");
+  countKernel<<<count, kThreads>>>(b.pairs, b.n, b.hypotheses, b.valid, max_squared_distance, cos_max_angle, b.counts);
+  check(cudaGetLastError(), "inlier kernel launch");
+  check(cudaMemcpy(counts, b.counts, std::size_t(count) * sizeof(int), cudaMemcpyDeviceToHost), "copy counts");
+}
+
+}  // namespace bundletrack::cuda::detail
