@@ -55,13 +55,32 @@ struct TwoNearest {
   bool distinct(float ratio) const { return index >= 0 && best < ratio * second; }
 };
 
-inline bool admitted(const MatchGate& gate, const FrameFeatures& first, int i, const FrameFeatures& second, int j) {
-  const float cos_max = std::cos(gate.max_normal_angle_deg * std::numbers::pi_v<float> / 180.0f);
-  const Eigen::Vector3f moved = gate.T_second_first * first.points[std::size_t(i)];
-  const Eigen::Vector3f turned = gate.T_second_first.rotation() * first.normals[std::size_t(i)];
-  return (moved - second.points[std::size_t(j)]).norm() <= gate.max_distance &&
-         turned.dot(second.normals[std::size_t(j)]) >= cos_max;
-}
+/// A MatchGate ready to test pairs: first's keypoint moved into the second frame once, then
+/// compared with any of second's.
+class GateTest {
+ public:
+  GateTest(const MatchGate& gate, const FrameFeatures& first, const FrameFeatures& second)
+      : gate_(gate), first_(first), second_(second), max_squared_distance_(gate.max_distance * gate.max_distance),
+        cos_max_angle_(std::cos(gate.max_normal_angle_deg * std::numbers::pi_v<float> / 180.0f)) {}
+
+  struct Moved {
+    Eigen::Vector3f point, normal;
+  };
+  Moved move(int i) const {
+    return {gate_.T_second_first * first_.points[std::size_t(i)],
+            gate_.T_second_first.rotation() * first_.normals[std::size_t(i)]};
+  }
+  bool admits(const Moved& moved, int j) const {
+    return (moved.point - second_.points[std::size_t(j)]).squaredNorm() <= max_squared_distance_ &&
+           moved.normal.dot(second_.normals[std::size_t(j)]) >= cos_max_angle_;
+  }
+
+ private:
+  const MatchGate& gate_;
+  const FrameFeatures& first_;
+  const FrameFeatures& second_;
+  float max_squared_distance_, cos_max_angle_;
+};
 
 /// Pairs that are each other's distinct nearest neighbour (forward[i]: first's keypoint i among
 /// second's, backward[j]: the other way), and that the gate admits when there is one. Sorted by
@@ -71,13 +90,20 @@ inline std::vector<FeatureMatch> mutualMatches(const std::vector<TwoNearest>& fo
                                                const FrameFeatures& second, float ratio,
                                                const std::optional<MatchGate>& gate) {
   std::vector<FeatureMatch> matches;
-  for (int i = 0; i < int(forward.size()); ++i) {
-    const TwoNearest& f = forward[std::size_t(i)];
-    if (!f.distinct(ratio)) continue;
-    const TwoNearest& b = backward[std::size_t(f.index)];
-    if (b.index != i || !b.distinct(ratio)) continue;
-    if (gate && !admitted(*gate, first, i, second, f.index)) continue;
-    matches.push_back({i, f.index});
+  const auto select = [&](const auto& admits) {
+    for (int i = 0; i < int(forward.size()); ++i) {
+      const TwoNearest& f = forward[std::size_t(i)];
+      if (!f.distinct(ratio)) continue;
+      const TwoNearest& b = backward[std::size_t(f.index)];
+      if (b.index != i || !b.distinct(ratio) || !admits(i, f.index)) continue;
+      matches.push_back({i, f.index});
+    }
+  };
+  if (gate) {
+    const GateTest test(*gate, first, second);
+    select([&](int i, int j) { return test.admits(test.move(i), j); });
+  } else {
+    select([](int, int) { return true; });
   }
   return matches;
 }
@@ -88,14 +114,11 @@ inline std::vector<FeatureMatch> matchGuided(const FrameFeatures& first, const F
                                              const MatchSettings& settings, const MatchGate& gate) {
   const int n1 = int(first.size()), n2 = int(second.size());
   std::vector<TwoNearest> forward(static_cast<std::size_t>(n1)), backward(static_cast<std::size_t>(n2));
-  const float cos_max = std::cos(gate.max_normal_angle_deg * std::numbers::pi_v<float> / 180.0f);
-  const float max_sq = gate.max_distance * gate.max_distance;
+  const GateTest test(gate, first, second);
   for (int i = 0; i < n1; ++i) {
-    const Eigen::Vector3f moved = gate.T_second_first * first.points[std::size_t(i)];
-    const Eigen::Vector3f turned = gate.T_second_first.rotation() * first.normals[std::size_t(i)];
+    const GateTest::Moved moved = test.move(i);
     for (int j = 0; j < n2; ++j) {
-      if ((moved - second.points[std::size_t(j)]).squaredNorm() > max_sq || turned.dot(second.normals[std::size_t(j)]) < cos_max)
-        continue;
+      if (!test.admits(moved, j)) continue;
       const float distance = descriptorDistance(first.descriptors.row(i), second.descriptors.row(j), first.norm_type);
       forward[std::size_t(i)].offer(distance, j);
       backward[std::size_t(j)].offer(distance, i);

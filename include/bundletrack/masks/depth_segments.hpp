@@ -22,6 +22,27 @@ struct DepthSegment {
 /// sensors does (Kinect v1: ~3 mm steps at 1 m, ~13 mm at 2 m).
 inline float continuityAt(float z, float continuity) { return continuity * std::max(1.0f, z * z); }
 
+/// Grows a region from the pixels in `frontier` over 4-neighbours whose depth differs by at most
+/// continuityAt(depth, continuity) from the pixel they are reached from: claim(q) decides whether
+/// neighbour q joins (and marks it), reached(p) sees every pixel of the region once.
+template <typename Claim, typename Reached>
+void growOverContinuousDepth(const cv::Mat& depth, float continuity, std::vector<cv::Point>& frontier, Claim&& claim,
+                             Reached&& reached) {
+  while (!frontier.empty()) {
+    const cv::Point p = frontier.back();
+    frontier.pop_back();
+    reached(p);
+    const float z = depth.at<float>(p);
+    for (const cv::Point step : {cv::Point(1, 0), cv::Point(-1, 0), cv::Point(0, 1), cv::Point(0, -1)}) {
+      const cv::Point q = p + step;
+      if (q.x < 0 || q.y < 0 || q.x >= depth.cols || q.y >= depth.rows) continue;
+      const float zq = depth.at<float>(q);
+      if (zq <= 0.0f || std::abs(zq - z) > continuityAt(z, continuity) || !claim(q)) continue;
+      frontier.push_back(q);
+    }
+  }
+}
+
 /// Splits the valid depth into surfaces that neighbouring pixels join when their depths differ by
 /// at most continuityAt(depth, continuity). `labels` (CV_32SC1) gets each pixel's segment index, -1 where
 /// depth is invalid; returns the segments with their sizes and 3-D bounding boxes.
@@ -38,23 +59,19 @@ inline std::vector<DepthSegment> segmentDepth(const cv::Mat& depth, const cv::Ma
       DepthSegment& segment = segments.emplace_back();
       labels.at<int>(v, u) = id;
       frontier.assign(1, {u, v});
-      while (!frontier.empty()) {
-        const cv::Point p = frontier.back();
-        frontier.pop_back();
-        const cv::Vec3f& x = points.at<cv::Vec3f>(p);
-        ++segment.pixels;
-        segment.low = segment.low.cwiseMin(Eigen::Vector3f(x[0], x[1], x[2]));
-        segment.high = segment.high.cwiseMax(Eigen::Vector3f(x[0], x[1], x[2]));
-        const float z = depth.at<float>(p);
-        for (const cv::Point step : {cv::Point(1, 0), cv::Point(-1, 0), cv::Point(0, 1), cv::Point(0, -1)}) {
-          const cv::Point q = p + step;
-          if (q.x < 0 || q.y < 0 || q.x >= depth.cols || q.y >= depth.rows || labels.at<int>(q) >= 0) continue;
-          const float zq = depth.at<float>(q);
-          if (zq <= 0.0f || std::abs(zq - z) > continuityAt(z, continuity)) continue;
-          labels.at<int>(q) = id;
-          frontier.push_back(q);
-        }
-      }
+      growOverContinuousDepth(
+          depth, continuity, frontier,
+          [&](const cv::Point& q) {
+            if (labels.at<int>(q) >= 0) return false;
+            labels.at<int>(q) = id;
+            return true;
+          },
+          [&](const cv::Point& p) {
+            const cv::Vec3f& x = points.at<cv::Vec3f>(p);
+            ++segment.pixels;
+            segment.low = segment.low.cwiseMin(Eigen::Vector3f(x[0], x[1], x[2]));
+            segment.high = segment.high.cwiseMax(Eigen::Vector3f(x[0], x[1], x[2]));
+          });
     }
   }
   return segments;

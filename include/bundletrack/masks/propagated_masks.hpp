@@ -102,19 +102,15 @@ class PropagatedMasks {
         if (agrees) frontier.emplace_back(u, v);
       }
     }
-    // Grow over depth-continuous candidates (4-neighbourhood flood fill from the seeds).
-    while (!frontier.empty()) {
-      const cv::Point p = frontier.back();
-      frontier.pop_back();
-      const float z = frame.depth.at<float>(p);
-      for (const cv::Point step : {cv::Point(1, 0), cv::Point(-1, 0), cv::Point(0, 1), cv::Point(0, -1)}) {
-        const cv::Point q = p + step;
-        if (!box.contains(q) || label.at<uchar>(q) != kCandidate) continue;
-        if (std::abs(frame.depth.at<float>(q) - z) > continuityAt(z, settings_.depth_continuity)) continue;
-        label.at<uchar>(q) = kObject;
-        frontier.push_back(q);
-      }
-    }
+    // Grow over depth-continuous candidates (candidates lie inside the box).
+    growOverContinuousDepth(
+        frame.depth, settings_.depth_continuity, frontier,
+        [&](const cv::Point& q) {
+          if (label.at<uchar>(q) != kCandidate) return false;
+          label.at<uchar>(q) = kObject;
+          return true;
+        },
+        [](const cv::Point&) {});
     return label == kObject;
   }
 
