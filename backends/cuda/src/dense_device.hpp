@@ -22,14 +22,17 @@ struct DirectedPass {
   double loss_parameter, weight;
 };
 
+/// The sums of a pass over its cells: w J^T J (36, row-major), w r J (6), the weighted losses and
+/// the count, with J = dr/dd_s (DensePointToPlane's documentation).
+constexpr int kDenseSums = 36 + 6 + 1 + 1;
+
 /// Device memory the sums of accumulateDense land in (one per caller at a time).
 struct DeviceSums;
 DeviceSums* createSums();
 void releaseSums(DeviceSums* sums);
 
-/// Sums over the surface cells of s associated with t: w J^T J (6x6 row-major, 36), w r J^T (6),
-/// the weighted losses and the count, with J = dr/dd_s (DensePointToPlane's documentation).
+/// The sums over the surface cells of s associated with t, copied to `out` on the host.
 void accumulateDense(DeviceSums& sums, const DeviceGrid& s, const DeviceGrid& t, const DirectedPass& pass,
-                     double JtWJ[36], double JtWr[6], double* cost, int* count);
+                     double out[kDenseSums]);
 
 }  // namespace bundletrack::cuda::detail

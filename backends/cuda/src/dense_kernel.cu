@@ -3,103 +3,26 @@
 #include <stdexcept>
 #include <string>
 
-#include "dense_device.hpp"
+#include "dense_cell.hpp"
 
 namespace bundletrack::cuda::detail {
 
 namespace {
 
 constexpr int kThreads = 128;
-constexpr int kSums = 36 + 6 + 1 + 1;  ///< JtWJ, JtWr, cost, count
 
 void check(cudaError_t status, const char* what) {
   if (status != cudaSuccess) throw std::runtime_error(std::string("CUDA ") + what + ": " + cudaGetErrorString(status));
-}
-
-__device__ void apply(const double* T, const double* p, double* out) {
-  for (int r = 0; r < 3; ++r) out[r] = T[4 * r] * p[0] + T[4 * r + 1] * p[1] + T[4 * r + 2] * p[2] + T[4 * r + 3];
-}
-
-__device__ void rotate(const double* T, const double* n, double* out) {
-  for (int r = 0; r < 3; ++r) out[r] = T[4 * r] * n[0] + T[4 * r + 1] * n[1] + T[4 * r + 2] * n[2];
-}
-
-/// rho(s) and rho'(s) of bundletrack's losses (robust/losses.hpp).
-__device__ void evaluateLoss(int kind, double c, double s, double* rho, double* d_rho) {
-  switch (kind) {
-    case 1:  // Huber
-      if (s <= c * c) *rho = s, *d_rho = 1.0;
-      else *rho = 2.0 * c * sqrt(s) - c * c, *d_rho = c / sqrt(s);
-      return;
-    case 2: {  // Cauchy
-      const double q = 1.0 + s / (c * c);
-      *rho = c * c * log(q), *d_rho = 1.0 / q;
-      return;
-    }
-    case 3: {  // Tukey
-      if (s > c * c) {
-        *rho = c * c / 3.0, *d_rho = 0.0;
-        return;
-      }
-      const double q = 1.0 - s / (c * c);
-      *rho = c * c / 3.0 * (1.0 - q * q * q), *d_rho = q * q;
-      return;
-    }
-    default: *rho = s, *d_rho = 1.0;
-  }
 }
 
 /// One thread per surface cell of s; warp sums, then one atomic add per warp and value.
 __global__ void denseKernel(const float* s_points, const float* s_normals, const int* s_cells, int count,
                             const float* t_points, const float* t_normals, int t_width, int t_height, DirectedPass pass,
                             double* sums) {
-  double local[kSums] = {};
+  double local[kDenseSums] = {};
   const int k = blockIdx.x * blockDim.x + threadIdx.x;
-  if (k < count) {
-    const int cell = s_cells[k];
-    const double p_s[3] = {s_points[3 * cell], s_points[3 * cell + 1], s_points[3 * cell + 2]};
-    double in_t[3];
-    apply(pass.T_t_s, p_s, in_t);
-    bool associated = in_t[2] > 0.0;
-    int u = 0, v = 0;
-    if (associated) {
-      u = __double2int_rn(pass.fx * in_t[0] / in_t[2] + pass.cx);
-      v = __double2int_rn(pass.fy * in_t[1] / in_t[2] + pass.cy);
-      associated = u >= 0 && v >= 0 && u < t_width && v < t_height;
-    }
-    const int at = v * t_width + u;
-    if (associated) associated = t_points[3 * at + 2] > 0.0f;
-    if (associated) {
-      const double p_t[3] = {t_points[3 * at], t_points[3 * at + 1], t_points[3 * at + 2]};
-      double back[3];
-      apply(pass.T_s_t, p_t, back);
-      const double dx = back[0] - p_s[0], dy = back[1] - p_s[1], dz = back[2] - p_s[2];
-      const double n_s[3] = {s_normals[3 * cell], s_normals[3 * cell + 1], s_normals[3 * cell + 2]};
-      const double n_t[3] = {t_normals[3 * at], t_normals[3 * at + 1], t_normals[3 * at + 2]};
-      double turned[3];
-      rotate(pass.T_s_t, n_t, turned);
-      if (dx * dx + dy * dy + dz * dz <= pass.max_sq &&
-          turned[0] * n_s[0] + turned[1] * n_s[1] + turned[2] * n_s[2] >= pass.cos_max) {
-        double m[3], a[3], b[3];
-        rotate(pass.T_s_inv, n_s, m);
-        apply(pass.T_s_inv, p_s, a);
-        apply(pass.T_t_inv, p_t, b);
-        const double r = m[0] * (b[0] - a[0]) + m[1] * (b[1] - a[1]) + m[2] * (b[2] - a[2]);
-        const double J[6] = {m[0], m[1], m[2], b[1] * m[2] - b[2] * m[1], b[2] * m[0] - b[0] * m[2],
-                             b[0] * m[1] - b[1] * m[0]};
-        double rho, d_rho;
-        evaluateLoss(pass.loss_kind, pass.loss_parameter, r * r, &rho, &d_rho);
-        const double w = pass.weight * d_rho;
-        for (int row = 0; row < 6; ++row) {
-          for (int col = 0; col < 6; ++col) local[6 * row + col] = w * J[row] * J[col];
-          local[36 + row] = w * r * J[row];
-        }
-        local[42] = pass.weight * rho;
-        local[43] = 1.0;
-      }
-    }
-  }
-  for (int i = 0; i < kSums; ++i) {
+  if (k < count) addDenseCell(s_points, s_normals, s_cells[k], t_points, t_normals, t_width, t_height, pass, local);
+  for (int i = 0; i < kDenseSums; ++i) {
     double value = local[i];
     for (int offset = 16; offset > 0; offset /= 2) value += __shfl_down_sync(0xffffffffu, value, offset);
     if ((threadIdx.x & 31) == 0 && value != 0.0) atomicAdd(sums + i, value);
@@ -142,7 +65,7 @@ void releaseGrid(DeviceGrid* grid) { delete grid; }
 
 struct DeviceSums {
   double* values = nullptr;
-  DeviceSums() { check(cudaMalloc(&values, kSums * sizeof(double)), "malloc"); }
+  DeviceSums() { check(cudaMalloc(&values, kDenseSums * sizeof(double)), "malloc"); }
   ~DeviceSums() { cudaFree(values); }
 };
 
@@ -150,19 +73,14 @@ DeviceSums* createSums() { return new DeviceSums; }
 void releaseSums(DeviceSums* sums) { delete sums; }
 
 void accumulateDense(DeviceSums& sums, const DeviceGrid& s, const DeviceGrid& t, const DirectedPass& pass,
-                     double JtWJ[36], double JtWr[6], double* cost, int* count) {
-  double host[kSums] = {};
-  if (s.count > 0) {
-    check(cudaMemset(sums.values, 0, kSums * sizeof(double)), "memset");
-    denseKernel<<<(s.count + kThreads - 1) / kThreads, kThreads>>>(s.points, s.normals, s.cells, s.count, t.points,
-                                                                   t.normals, t.width, t.height, pass, sums.values);
-    check(cudaGetLastError(), "dense kernel launch");
-    check(cudaMemcpy(host, sums.values, kSums * sizeof(double), cudaMemcpyDeviceToHost), "copy dense sums");
-  }
-  for (int i = 0; i < 36; ++i) JtWJ[i] = host[i];
-  for (int i = 0; i < 6; ++i) JtWr[i] = host[36 + i];
-  *cost = host[42];
-  *count = int(host[43] + 0.5);
+                     double out[kDenseSums]) {
+  for (int i = 0; i < kDenseSums; ++i) out[i] = 0.0;
+  if (s.count == 0) return;
+  check(cudaMemset(sums.values, 0, kDenseSums * sizeof(double)), "memset");
+  denseKernel<<<(s.count + kThreads - 1) / kThreads, kThreads>>>(s.points, s.normals, s.cells, s.count, t.points,
+                                                                 t.normals, t.width, t.height, pass, sums.values);
+  check(cudaGetLastError(), "dense kernel launch");
+  check(cudaMemcpy(out, sums.values, kDenseSums * sizeof(double), cudaMemcpyDeviceToHost), "copy dense sums");
 }
 
 }  // namespace bundletrack::cuda::detail

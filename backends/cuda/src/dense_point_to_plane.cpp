@@ -1,14 +1,11 @@
 #include "bundletrack/cuda/dense_point_to_plane.hpp"
 
-#include <cmath>
 #include <cstdint>
-#include <cstring>
 #include <map>
 #include <mutex>
-#include <numbers>
 #include <vector>
 
-#include "dense_device.hpp"
+#include "dense_host.hpp"
 
 namespace bundletrack::cuda {
 
@@ -30,12 +27,6 @@ std::uint64_t signature(const Keyframe& k) {
   for (std::size_t i = 0; i < ends; ++i) mix(&k.points.at<cv::Vec3f>(k.surface[i]), sizeof(cv::Vec3f));
   for (std::size_t i = n - ends; i < n; ++i) mix(&k.points.at<cv::Vec3f>(k.surface[i]), sizeof(cv::Vec3f));
   return h;
-}
-
-void rowMajor3x4(const SE3d& T, double out[12]) {
-  const Eigen::Matrix4d M = T.matrix();
-  for (int r = 0; r < 3; ++r)
-    for (int c = 0; c < 4; ++c) out[4 * r + c] = M(r, c);
 }
 
 }  // namespace
@@ -77,8 +68,7 @@ struct DensePointToPlane::Workspace {
       }
       const cv::Mat points = k.points.isContinuous() ? k.points : k.points.clone();
       const cv::Mat normals = k.normals.isContinuous() ? k.normals : k.normals.clone();
-      std::vector<int> cells(k.surface.size());
-      for (std::size_t i = 0; i < cells.size(); ++i) cells[i] = k.surface[i].y * k.points.cols + k.surface[i].x;
+      const std::vector<int> cells = detail::surfaceCells(k);
       found = grids.emplace(k.id, Entry{detail::uploadGrid(points.ptr<float>(), normals.ptr<float>(), points.cols,
                                                             points.rows, cells.data(), int(cells.size())),
                                         sig, 0})
@@ -99,24 +89,11 @@ void DensePointToPlane::lineariseWith(const PairInput& in, const LossParameters&
   const detail::DeviceGrid& grid_j = w.grid(in.j);
   const auto pass = [&](const detail::DeviceGrid& s, const detail::DeviceGrid& t, const SE3d& T_s, const SE3d& T_t,
                         bool swapped) {
-    detail::DirectedPass p{};
-    rowMajor3x4(T_t * T_s.inverse(), p.T_t_s);
-    rowMajor3x4(T_s * T_t.inverse(), p.T_s_t);
-    rowMajor3x4(T_s.inverse(), p.T_s_inv);
-    rowMajor3x4(T_t.inverse(), p.T_t_inv);
-    p.cos_max = std::cos(double(max_normal_angle_deg) * std::numbers::pi / 180.0);
-    p.max_sq = double(max_distance) * double(max_distance);
-    p.fx = in.grid_camera.fx, p.fy = in.grid_camera.fy, p.cx = in.grid_camera.cx, p.cy = in.grid_camera.cy;
-    p.loss_kind = int(loss.kind);
-    p.loss_parameter = loss.parameter;
-    p.weight = weight;
-    double JtWJ[36], JtWr[6], cost = 0.0;
-    int count = 0;
-    detail::accumulateDense(*w.sums, s, t, p, JtWJ, JtWr, &cost, &count);
-    // J_i is J_s, or -J_s when s is the edge's second node: J^T J keeps its sign, J^T r flips.
-    const Eigen::Matrix<double, 6, 1> b = Eigen::Map<const Eigen::Matrix<double, 6, 1>>(JtWr);
-    system.addRelativeSums(Eigen::Map<const Eigen::Matrix<double, 6, 6, Eigen::RowMajor>>(JtWJ), swapped ? -b : b, cost,
-                           count);
+    const detail::DirectedPass p = detail::directedPass(T_s, T_t, in.grid_camera, max_distance, max_normal_angle_deg,
+                                                        loss, weight);
+    double sums[detail::kDenseSums];
+    detail::accumulateDense(*w.sums, s, t, p, sums);
+    detail::addPassSums(sums, swapped, system);
   };
   pass(grid_i, grid_j, in.T_i, in.T_j, false);
   pass(grid_j, grid_i, in.T_j, in.T_i, true);

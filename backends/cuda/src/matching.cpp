@@ -1,10 +1,10 @@
 #include "bundletrack/cuda/matching.hpp"
 
-#include <cstring>
 #include <mutex>
 #include <stdexcept>
 
 #include "matching_device.hpp"
+#include "matching_host.hpp"
 
 namespace bundletrack::cuda {
 
@@ -15,17 +15,6 @@ struct DescriptorMatcher::Workspace {
 };
 
 DescriptorMatcher::DescriptorMatcher() : workspace_(std::make_shared<Workspace>()) {}
-
-namespace {
-
-/// CV_8U rows packed into zero-padded 32-bit words (the padding XORs to zero).
-std::vector<std::uint32_t> packWords(const cv::Mat& rows, int words) {
-  std::vector<std::uint32_t> packed(std::size_t(rows.rows) * std::size_t(words), 0u);
-  for (int r = 0; r < rows.rows; ++r) std::memcpy(packed.data() + std::size_t(r) * std::size_t(words), rows.ptr(r), std::size_t(rows.cols));
-  return packed;
-}
-
-}  // namespace
 
 std::vector<TwoNearest> DescriptorMatcher::twoNearest(const cv::Mat& query, const cv::Mat& train, int norm_type) const {
   if (query.cols != train.cols || query.type() != train.type())
@@ -40,7 +29,7 @@ std::vector<TwoNearest> DescriptorMatcher::twoNearest(const cv::Mat& query, cons
                          best.data(), second.data());
   } else if (norm_type == cv::NORM_HAMMING && query.type() == CV_8U) {
     const int words = (query.cols + 3) / 4;
-    const auto q = packWords(query, words), t = packWords(train, words);
+    const auto q = detail::packWords(query, words), t = detail::packWords(train, words);
     detail::twoNearestHamming(*workspace_->buffers, q.data(), queries, t.data(), trains, words, index.data(), best.data(),
                               second.data());
   } else {

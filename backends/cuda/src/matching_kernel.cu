@@ -5,6 +5,7 @@
 #include <string>
 
 #include "matching_device.hpp"
+#include "matching_metric.hpp"
 
 namespace bundletrack::cuda::detail {
 
@@ -17,25 +18,6 @@ constexpr int kMaxSharedBytes = 48 * 1024;
 void check(cudaError_t status, const char* what) {
   if (status != cudaSuccess) throw std::runtime_error(std::string("CUDA ") + what + ": " + cudaGetErrorString(status));
 }
-
-struct L2 {
-  __device__ static float distance(const float* a, const float* b, int width) {
-    float sum = 0.0f;
-    for (int k = 0; k < width; ++k) {
-      const float d = a[k] - b[k];
-      sum += d * d;
-    }
-    return sqrtf(sum);
-  }
-};
-
-struct Hamming {
-  __device__ static float distance(const std::uint32_t* a, const std::uint32_t* b, int width) {
-    int bits = 0;
-    for (int k = 0; k < width; ++k) bits += __popc(a[k] ^ b[k]);
-    return float(bits);
-  }
-};
 
 /// One thread per query row; the block stages kTile train rows at a time in shared memory. Ties
 /// go to the lower train index, as in the CPU matcher.
@@ -54,8 +36,7 @@ __global__ void twoNearestKernel(const Word* query, int queries, const Word* tra
     if (q < queries) {
       for (int t = 0; t < count; ++t) {
         const float d = Metric::distance(query + q * width, tile + t * width, width);
-        if (d < b) s = b, b = d, nearest = start + t;
-        else if (d < s) s = d;
+        keepTwoNearest(d, start + t, b, s, nearest);
       }
     }
     __syncthreads();

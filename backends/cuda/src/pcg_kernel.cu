@@ -4,6 +4,7 @@
 #include <string>
 
 #include "pcg_device.hpp"
+#include "pcg_loop.hpp"
 
 namespace bundletrack::cuda::detail {
 
@@ -15,30 +16,25 @@ void check(cudaError_t status, const char* what) {
   if (status != cudaSuccess) throw std::runtime_error(std::string("CUDA ") + what + ": " + cudaGetErrorString(status));
 }
 
-/// Sum over the block of each thread's `value` (every thread gets the total).
-__device__ float blockSum(float value, float* scratch) {
-  scratch[threadIdx.x] = value;
-  __syncthreads();
-  for (int stride = blockDim.x / 2; stride > 0; stride /= 2) {
-    if (threadIdx.x < stride) scratch[threadIdx.x] += scratch[threadIdx.x + stride];
-    __syncthreads();
-  }
-  const float total = scratch[0];
-  __syncthreads();
-  return total;
-}
+/// The threads of one block; sum() leaves the total with every thread.
+struct BlockTeam {
+  float* scratch;  ///< kThreads floats of shared memory
 
-/// z = M^-1 r with M^-1 block diagonal (6x6 blocks, row-major).
-__device__ void precondition(const float* block_inverse, const float* r, float* z, int n) {
-  for (int i = threadIdx.x; i < n; i += blockDim.x) {
-    const int block = i / 6, row = i % 6;
-    const float* m = block_inverse + 36 * block + 6 * row;
-    float sum = 0.0f;
-    for (int c = 0; c < 6; ++c) sum += m[c] * r[6 * block + c];
-    z[i] = sum;
+  __device__ int rank() const { return threadIdx.x; }
+  __device__ int size() const { return blockDim.x; }
+  __device__ void sync() const { __syncthreads(); }
+  __device__ float sum(float value) const {
+    scratch[threadIdx.x] = value;
+    __syncthreads();
+    for (int stride = blockDim.x / 2; stride > 0; stride /= 2) {
+      if (threadIdx.x < stride) scratch[threadIdx.x] += scratch[threadIdx.x + stride];
+      __syncthreads();
+    }
+    const float total = scratch[0];
+    __syncthreads();
+    return total;
   }
-  __syncthreads();
-}
+};
 
 /// The whole PCG loop in one block: the systems are small (6 unknowns per keyframe), so one launch
 /// and block-wide reductions beat a launch per vector operation.
@@ -46,41 +42,10 @@ __global__ void pcgKernel(const float* H, const float* block_inverse, const floa
                           float* p, float* Hp, int n, int max_iterations, float tolerance, int* iterations_out,
                           float* residual_out) {
   __shared__ float scratch[kThreads];
-  float bb = 0.0f;
-  for (int i = threadIdx.x; i < n; i += blockDim.x) x[i] = 0.0f, r[i] = b[i], bb += b[i] * b[i];
-  const float b_norm = sqrtf(blockSum(bb, scratch));
-  precondition(block_inverse, r, z, n);
-  float rz = 0.0f, rr = 0.0f;
-  for (int i = threadIdx.x; i < n; i += blockDim.x) p[i] = z[i], rz += r[i] * z[i], rr += r[i] * r[i];
-  rz = blockSum(rz, scratch);
-  rr = blockSum(rr, scratch);
-  int iteration = 0;
-  while (iteration < max_iterations && b_norm > 0.0f && sqrtf(rr) > tolerance * b_norm) {
-    float pHp = 0.0f;
-    for (int i = threadIdx.x; i < n; i += blockDim.x) {
-      float sum = 0.0f;
-      for (int c = 0; c < n; ++c) sum += H[i * n + c] * p[c];
-      Hp[i] = sum;
-      pHp += p[i] * sum;
-    }
-    pHp = blockSum(pHp, scratch);
-    if (!(pHp > 0.0f)) break;
-    const float alpha = rz / pHp;
-    for (int i = threadIdx.x; i < n; i += blockDim.x) x[i] += alpha * p[i], r[i] -= alpha * Hp[i];
-    __syncthreads();
-    precondition(block_inverse, r, z, n);
-    float rz_next = 0.0f;
-    rr = 0.0f;
-    for (int i = threadIdx.x; i < n; i += blockDim.x) rz_next += r[i] * z[i], rr += r[i] * r[i];
-    rz_next = blockSum(rz_next, scratch);
-    rr = blockSum(rr, scratch);
-    const float beta = rz_next / rz;
-    for (int i = threadIdx.x; i < n; i += blockDim.x) p[i] = z[i] + beta * p[i];
-    __syncthreads();
-    rz = rz_next;
-    ++iteration;
-  }
-  if (threadIdx.x == 0) *iterations_out = iteration, *residual_out = b_norm > 0.0f ? sqrtf(rr) / b_norm : 0.0f;
+  float residual = 0.0f;
+  const int iterations = pcgIterations(BlockTeam{scratch}, H, block_inverse, b, x, r, z, p, Hp, n, max_iterations,
+                                       tolerance, &residual);
+  if (threadIdx.x == 0) *iterations_out = iterations, *residual_out = residual;
 }
 
 }  // namespace

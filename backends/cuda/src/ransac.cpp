@@ -3,6 +3,7 @@
 #include <mutex>
 
 #include "ransac_device.hpp"
+#include "ransac_host.hpp"
 
 namespace bundletrack::cuda {
 
@@ -20,16 +21,7 @@ InlierCounter::InlierCounter() : workspace_(std::make_shared<Workspace>()) {}
 void InlierCounter::prepare(const MatchedPoints& pairs) {
   Workspace& w = *workspace_;
   const std::lock_guard lock(w.mutex);
-  w.staging.resize(12 * pairs.size());
-  for (std::size_t k = 0; k < pairs.size(); ++k) {
-    float* pair = w.staging.data() + 12 * k;
-    for (int r = 0; r < 3; ++r) {
-      pair[r] = pairs.first[k][r];
-      pair[3 + r] = pairs.second[k][r];
-      pair[6 + r] = pairs.first_normals[k][r];
-      pair[9 + r] = pairs.second_normals[k][r];
-    }
-  }
+  detail::packPairs(pairs, w.staging);
   detail::uploadPairs(*w.buffers, w.staging.data(), int(pairs.size()));
   w.prepared = &pairs;
 }
@@ -39,14 +31,9 @@ void InlierCounter::count(const MatchedPoints& pairs, const std::vector<SE3f>& h
   Workspace& w = *workspace_;
   const std::lock_guard lock(w.mutex);
   if (w.prepared != &pairs) throw std::logic_error("cuda::InlierCounter::count() before prepare() of these pairs");
-  w.staging.resize(12 * hypotheses.size());
+  detail::packHypotheses(hypotheses, w.staging);
   w.valid.resize(hypotheses.size());
-  for (std::size_t h = 0; h < hypotheses.size(); ++h) {
-    const Eigen::Matrix4f T = hypotheses[h].matrix();
-    for (int r = 0; r < 3; ++r)
-      for (int c = 0; c < 4; ++c) w.staging[12 * h + std::size_t(4 * r + c)] = T(r, c);
-    w.valid[h] = valid[h] ? 1 : 0;
-  }
+  for (std::size_t h = 0; h < hypotheses.size(); ++h) w.valid[h] = valid[h] ? 1 : 0;
   counts.resize(hypotheses.size());
   detail::countInliers(*w.buffers, w.staging.data(), w.valid.data(), int(hypotheses.size()), gate.max_squared_distance,
                        gate.cos_max_angle, counts.data());

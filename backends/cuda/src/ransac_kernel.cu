@@ -4,6 +4,7 @@
 #include <string>
 
 #include "ransac_device.hpp"
+#include "ransac_pair.hpp"
 
 namespace bundletrack::cuda::detail {
 
@@ -23,17 +24,8 @@ __global__ void countKernel(const float* pairs, int n, const float* hypotheses, 
   int inliers = 0;
   if (valid[h]) {
     const float* T = hypotheses + 12 * h;
-    for (int k = threadIdx.x; k < n; k += blockDim.x) {
-      const float* pair = pairs + 12 * k;
-      float distance = 0.0f, cosine = 0.0f;
-      for (int r = 0; r < 3; ++r) {
-        const float moved = T[4 * r] * pair[0] + T[4 * r + 1] * pair[1] + T[4 * r + 2] * pair[2] + T[4 * r + 3];
-        const float turned = T[4 * r] * pair[6] + T[4 * r + 1] * pair[7] + T[4 * r + 2] * pair[8];
-        distance += (moved - pair[3 + r]) * (moved - pair[3 + r]);
-        cosine += turned * pair[9 + r];
-      }
-      inliers += distance < max_squared_distance && cosine > cos_max_angle;
-    }
+    for (int k = threadIdx.x; k < n; k += blockDim.x)
+      inliers += isInlier(T, pairs + 12 * k, max_squared_distance, cos_max_angle);
   }
   partial[threadIdx.x] = inliers;
   __syncthreads();
