@@ -5,12 +5,13 @@
 #include "bundletrack/cuda/dense_point_to_plane.hpp"
 #include "bundletrack/cuda/pcg.hpp"
 #include "bundletrack/residuals/dense_point_to_plane.hpp"
+#include "bundletrack/solvers/gauss_newton.hpp"
 #include "bundletrack/synth/synthetic_sequence.hpp"
 
 namespace bt = bundletrack;
 namespace synth = bundletrack::synth;
 
-static_assert(bt::Residual<bt::cuda::DensePointToPlane>, "the GPU dense term composes like the CPU one");
+static_assert(bt::BatchResidual<bt::cuda::DensePointToPlane>, "the GPU dense term composes like the CPU one, in batches");
 
 namespace {
 
@@ -67,4 +68,49 @@ TEST_CASE("GPU dense point-to-plane term equals the CPU term for every loss, wit
   moved.points += cv::Scalar(0.001, 0.0, 0.0);
   bt::indexSurface(moved);
   compare(keyframes[0], moved, truth[0], nudge * truth[1], grid, bt::HuberLoss{}, gpu);
+}
+
+TEST_CASE("GPU dense term assembles a whole graph in one launch as the CPU term does edge by edge") {
+  if (!bt::cuda::deviceAvailable()) {
+    MESSAGE("SKIPPED: no CUDA device");
+    return;
+  }
+  synth::SyntheticSequenceSettings settings;
+  settings.frames = 10;
+  const synth::SyntheticScene scene(settings);
+  const auto camera = settings.camera.cast<float>();
+  const int step = 4;
+  std::vector<bt::Keyframe> keyframes;
+  std::vector<bt::SE3d> poses;
+  for (const int i : {0, 3, 6, 9}) {
+    const synth::SyntheticFrame f = scene.frame(i);
+    const bt::RgbdFrame frame = bt::makeFrame(std::to_string(i), f.color, f.depth, f.mask, camera);
+    keyframes.push_back(bt::makeKeyframe(i, frame, frame.mask, {}, f.T_cam_obj, step));
+    const double k = double(poses.size());
+    poses.push_back(bt::SE3d::exp((Eigen::Matrix<double, 6, 1>() << 0.002 * k, -0.001 * k, 0.003, 0.005 * k, -0.01, 0.004).finished()) *
+                    f.T_cam_obj);
+  }
+  poses[0] = scene.frame(0).T_cam_obj;
+  const std::vector<bt::FeatureMatch> none;
+  std::vector<const bt::Keyframe*> nodes;
+  std::vector<bt::GraphEdge> edges;
+  for (const auto& k : keyframes) nodes.push_back(&k);
+  for (int a = 0; a < 4; ++a)
+    for (int b = a + 1; b < 4; ++b) edges.push_back({a, b, &none});
+  const bt::PinholeCameraf grid = bt::downsampledCamera(camera, step);
+  Eigen::MatrixXd H_cpu, H_gpu;
+  Eigen::VectorXd b_cpu, b_gpu;
+  int residuals_cpu = 0, residuals_gpu = 0;
+  const double cost_cpu = bt::assembleNormalEquations(bt::Energy<bt::Term<bt::DensePointToPlane, bt::HuberLoss>>{}, nodes,
+                                                      edges, grid, poses, H_cpu, b_cpu, residuals_cpu);
+  const bt::Energy<bt::Term<bt::cuda::DensePointToPlane, bt::HuberLoss>> gpu;
+  for (int repeat = 0; repeat < 2; ++repeat) {  // the second time with the grids already on the device
+    const double cost_gpu = bt::assembleNormalEquations(gpu, nodes, edges, grid, poses, H_gpu, b_gpu, residuals_gpu);
+    REQUIRE(residuals_cpu > 3000);
+    CHECK(std::abs(residuals_gpu - residuals_cpu) <= residuals_cpu / 1000 + 1);
+    const double tolerance = residuals_gpu == residuals_cpu ? 1e-4 : 1e-2;
+    CHECK((H_gpu - H_cpu).norm() <= tolerance * H_cpu.norm());
+    CHECK((b_gpu - b_cpu).norm() <= tolerance * b_cpu.norm());
+    CHECK(cost_gpu == doctest::Approx(cost_cpu).epsilon(tolerance));
+  }
 }

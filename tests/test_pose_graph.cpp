@@ -1,7 +1,9 @@
 // Robust losses, residual Jacobians, linear solvers and Gauss-Newton against independent references.
 #include <doctest/doctest.h>
 
+#include <memory>
 #include <random>
+#include <span>
 
 #include "bundletrack/energy.hpp"
 #include "bundletrack/graph/keyframe_pool.hpp"
@@ -62,6 +64,25 @@ bt::Keyframe surfaceKeyframe(int id, const bt::SE3d& T_cam_obj, const bt::Pinhol
   bt::indexSurface(k);
   return k;
 }
+
+/// The CPU dense term behind the batch interface, recording the size of every batch it is given.
+struct BatchedDense {
+  bt::DensePointToPlane dense;
+  std::shared_ptr<std::vector<std::size_t>> batches = std::make_shared<std::vector<std::size_t>>();
+
+  template <bt::RobustLoss Loss>
+  void linearise(const bt::PairInput& in, const Loss& loss, double weight, bt::PairSystem& system) const {
+    dense.linearise(in, loss, weight, system);
+  }
+  template <bt::RobustLoss Loss>
+  void lineariseAll(std::span<const bt::PairInput> inputs, const Loss& loss, double weight,
+                    std::span<bt::PairSystem> systems) const {
+    batches->push_back(inputs.size());
+    for (std::size_t e = 0; e < inputs.size(); ++e) dense.linearise(inputs[e], loss, weight, systems[e]);
+  }
+};
+static_assert(bt::BatchResidual<BatchedDense>);
+static_assert(!bt::BatchResidual<bt::DensePointToPlane>);
 
 }  // namespace
 
@@ -185,6 +206,47 @@ TEST_CASE("Gauss-Newton brings perturbed poses back to the truth, node 0 fixed")
     CHECK((poses[k].translation() - truth[k].translation()).norm() < 1e-3);
     CHECK(bt::rotationGeodesic(poses[k].rotation(), truth[k].rotation()) * 180.0 / 3.14159 < 0.2);
   }
+}
+
+TEST_CASE("a batch residual gets every edge of the graph in one call and adds what the edge-wise term adds") {
+  std::mt19937 rng(11);
+  const bt::PinholeCameraf grid{150.0f, 150.0f, 39.5f, 29.5f};
+  std::vector<bt::Keyframe> frames;
+  std::vector<bt::SE3d> poses;
+  for (int k = 0; k < 4; ++k) {
+    const bt::SE3d T(bt::SO3d::exp(Eigen::Vector3d(2.8 + 0.05 * k, 0.04 * k, -0.03 * k)),
+                     Eigen::Vector3d(0.01 * k, -0.005 * k, 0.6 + 0.01 * k));
+    frames.push_back(surfaceKeyframe(k, T, grid));
+    poses.push_back(k == 0 ? T : perturbed(T, rng, 0.003));
+  }
+  // Features "correspond" by index, as far as every frame has one: the feature term only has to
+  // contribute, not to be right.
+  std::size_t common = frames[0].features.size();
+  for (const auto& f : frames) common = std::min(common, f.features.size());
+  std::vector<bt::FeatureMatch> matches;
+  for (int f = 0; f < int(common); ++f) matches.push_back({f, f});
+  std::vector<const bt::Keyframe*> nodes;
+  std::vector<bt::GraphEdge> edges;
+  for (const auto& f : frames) nodes.push_back(&f);
+  for (int a = 0; a < 4; ++a)
+    for (int b = a + 1; b < 4; ++b) edges.push_back({a, b, &matches});
+  using EdgeWise = bt::Energy<bt::Term<bt::FeaturePointToPoint, bt::HuberLoss>, bt::Term<bt::DensePointToPlane, bt::HuberLoss>>;
+  using Batched = bt::Energy<bt::Term<bt::FeaturePointToPoint, bt::HuberLoss>, bt::Term<BatchedDense, bt::HuberLoss>>;
+  const Batched batched;
+  Eigen::MatrixXd H_edge, H_batch;
+  Eigen::VectorXd b_edge, b_batch;
+  int residuals_edge = 0, residuals_batch = 0;
+  const double cost_edge = bt::assembleNormalEquations(EdgeWise{}, nodes, edges, grid, poses, H_edge, b_edge, residuals_edge);
+  const double cost_batch = bt::assembleNormalEquations(batched, nodes, edges, grid, poses, H_batch, b_batch, residuals_batch);
+  REQUIRE(residuals_edge > 1000);
+  // Per edge the terms add in the same order, so the sums are the same to the last bit.
+  CHECK(residuals_batch == residuals_edge);
+  CHECK(cost_batch == cost_edge);
+  CHECK(H_batch == H_edge);
+  CHECK(b_batch == b_edge);
+  const auto& batches = *std::get<1>(batched.terms).residual.batches;
+  REQUIRE(batches.size() == 1);
+  CHECK(batches[0] == edges.size());
 }
 
 TEST_CASE("keyframe pool: greedy selection keeps frame 0 and follows the geodesic sums, and the pool is bounded") {

@@ -26,13 +26,19 @@ struct DirectedPass {
 /// the count, with J = dr/dd_s (DensePointToPlane's documentation).
 constexpr int kDenseSums = 36 + 6 + 1 + 1;
 
-/// Device memory the sums of accumulateDense land in (one per caller at a time).
-struct DeviceSums;
-DeviceSums* createSums();
-void releaseSums(DeviceSums* sums);
+/// A pass of a batch: the cells of grid s associated with grid t.
+struct BatchPass {
+  const DeviceGrid* s;
+  const DeviceGrid* t;
+  DirectedPass pass;
+};
 
-/// The sums over the surface cells of s associated with t, copied to `out` on the host.
-void accumulateDense(DeviceSums& sums, const DeviceGrid& s, const DeviceGrid& t, const DirectedPass& pass,
-                     double out[kDenseSums]);
+/// Device memory of one caller's batches, grown on demand (owned by the .cu side).
+struct DeviceBatch;
+DeviceBatch* createBatch();
+void releaseBatch(DeviceBatch* batch);
+
+/// The sums of `count` passes in one launch, copied to `out` (count x kDenseSums) on the host.
+void accumulateDense(DeviceBatch& batch, const BatchPass* passes, int count, double* out);
 
 }  // namespace bundletrack::cuda::detail

@@ -1,7 +1,9 @@
 #include <cuda_runtime.h>
 
+#include <algorithm>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include "dense_cell.hpp"
 
@@ -15,18 +17,41 @@ void check(cudaError_t status, const char* what) {
   if (status != cudaSuccess) throw std::runtime_error(std::string("CUDA ") + what + ": " + cudaGetErrorString(status));
 }
 
-/// One thread per surface cell of s; warp sums, then one atomic add per warp and value.
-__global__ void denseKernel(const float* s_points, const float* s_normals, const int* s_cells, int count,
-                            const float* t_points, const float* t_normals, int t_width, int t_height, DirectedPass pass,
-                            double* sums) {
+/// A pass as the kernel reads it: the grids' device pointers and the pass parameters.
+struct KernelPass {
+  const float* s_points;
+  const float* s_normals;
+  const int* s_cells;
+  int s_count;
+  const float* t_points;
+  const float* t_normals;
+  int t_width, t_height;
+  DirectedPass pass;
+};
+
+/// Block row y works on pass y, one thread per surface cell of its s; warp sums, then one atomic
+/// add per warp and value into the pass's kDenseSums slots.
+__global__ void denseKernel(const KernelPass* passes, double* sums) {
+  const KernelPass& p = passes[blockIdx.y];
+  if (int(blockIdx.x * blockDim.x) >= p.s_count) return;  // the whole block: s has fewer cells
   double local[kDenseSums] = {};
   const int k = blockIdx.x * blockDim.x + threadIdx.x;
-  if (k < count) addDenseCell(s_points, s_normals, s_cells[k], t_points, t_normals, t_width, t_height, pass, local);
+  if (k < p.s_count)
+    addDenseCell(p.s_points, p.s_normals, p.s_cells[k], p.t_points, p.t_normals, p.t_width, p.t_height, p.pass, local);
+  double* out = sums + std::size_t(kDenseSums) * blockIdx.y;
   for (int i = 0; i < kDenseSums; ++i) {
     double value = local[i];
     for (int offset = 16; offset > 0; offset /= 2) value += __shfl_down_sync(0xffffffffu, value, offset);
-    if ((threadIdx.x & 31) == 0 && value != 0.0) atomicAdd(sums + i, value);
+    if ((threadIdx.x & 31) == 0 && value != 0.0) atomicAdd(out + i, value);
   }
+}
+
+template <typename T>
+void grow(T*& buffer, std::size_t& capacity, std::size_t count) {
+  if (count <= capacity) return;
+  if (buffer) check(cudaFree(buffer), "free");
+  check(cudaMalloc(&buffer, count * sizeof(T)), "malloc");
+  capacity = count;
 }
 
 }  // namespace
@@ -63,24 +88,45 @@ DeviceGrid* uploadGrid(const float* points, const float* normals, int width, int
 
 void releaseGrid(DeviceGrid* grid) { delete grid; }
 
-struct DeviceSums {
-  double* values = nullptr;
-  DeviceSums() { check(cudaMalloc(&values, kDenseSums * sizeof(double)), "malloc"); }
-  ~DeviceSums() { cudaFree(values); }
+struct DeviceBatch {
+  KernelPass* passes = nullptr;
+  double* sums = nullptr;
+  std::size_t pass_capacity = 0, sum_capacity = 0;
+  std::vector<KernelPass> staging;
+
+  ~DeviceBatch() {
+    if (passes) cudaFree(passes);
+    if (sums) cudaFree(sums);
+  }
 };
 
-DeviceSums* createSums() { return new DeviceSums; }
-void releaseSums(DeviceSums* sums) { delete sums; }
+DeviceBatch* createBatch() { return new DeviceBatch; }
+void releaseBatch(DeviceBatch* batch) { delete batch; }
 
-void accumulateDense(DeviceSums& sums, const DeviceGrid& s, const DeviceGrid& t, const DirectedPass& pass,
-                     double out[kDenseSums]) {
-  for (int i = 0; i < kDenseSums; ++i) out[i] = 0.0;
-  if (s.count == 0) return;
-  check(cudaMemset(sums.values, 0, kDenseSums * sizeof(double)), "memset");
-  denseKernel<<<(s.count + kThreads - 1) / kThreads, kThreads>>>(s.points, s.normals, s.cells, s.count, t.points,
-                                                                 t.normals, t.width, t.height, pass, sums.values);
+void accumulateDense(DeviceBatch& batch, const BatchPass* passes, int count, double* out) {
+  const std::size_t values = std::size_t(kDenseSums) * std::size_t(count);
+  for (std::size_t i = 0; i < values; ++i) out[i] = 0.0;
+  if (count <= 0) return;
+  if (count > 65535) throw std::runtime_error("GPU dense term: more than 65535 passes in one batch");
+  batch.staging.resize(std::size_t(count));
+  int most_cells = 0;
+  for (int e = 0; e < count; ++e) {
+    const DeviceGrid& s = *passes[e].s;
+    const DeviceGrid& t = *passes[e].t;
+    batch.staging[std::size_t(e)] = {s.points, s.normals, s.cells, s.count, t.points, t.normals, t.width, t.height,
+                                     passes[e].pass};
+    most_cells = std::max(most_cells, s.count);
+  }
+  if (most_cells == 0) return;
+  grow(batch.passes, batch.pass_capacity, std::size_t(count));
+  grow(batch.sums, batch.sum_capacity, values);
+  check(cudaMemcpy(batch.passes, batch.staging.data(), std::size_t(count) * sizeof(KernelPass), cudaMemcpyHostToDevice),
+        "copy passes");
+  check(cudaMemset(batch.sums, 0, values * sizeof(double)), "memset");
+  const dim3 blocks(unsigned((most_cells + kThreads - 1) / kThreads), unsigned(count));
+  denseKernel<<<blocks, kThreads>>>(batch.passes, batch.sums);
   check(cudaGetLastError(), "dense kernel launch");
-  check(cudaMemcpy(out, sums.values, kDenseSums * sizeof(double), cudaMemcpyDeviceToHost), "copy dense sums");
+  check(cudaMemcpy(out, batch.sums, values * sizeof(double), cudaMemcpyDeviceToHost), "copy dense sums");
 }
 
 }  // namespace bundletrack::cuda::detail

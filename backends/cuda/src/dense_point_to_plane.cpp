@@ -3,6 +3,8 @@
 #include <cstdint>
 #include <map>
 #include <mutex>
+#include <stdexcept>
+#include <string>
 #include <vector>
 
 #include "dense_host.hpp"
@@ -40,31 +42,41 @@ struct DensePointToPlane::Workspace {
     std::uint64_t last_use;
   };
 
-  std::mutex mutex;  // edges linearise in parallel; device state is touched by one at a time
+  std::mutex mutex;  // one batch at a time touches the device state
   std::map<int, Entry> grids;
-  detail::DeviceSums* sums = detail::createSums();
-  std::uint64_t clock = 0;
+  detail::DeviceBatch* batch = detail::createBatch();
+  std::vector<detail::BatchPass> passes;
+  std::vector<double> sums;
+  std::uint64_t batch_clock = 0;  ///< counts batches; a grid used by the current one is not evicted
 
   ~Workspace() {
     for (auto& [id, entry] : grids) detail::releaseGrid(entry.grid);
-    detail::releaseSums(sums);
+    detail::releaseBatch(batch);
   }
 
-  const detail::DeviceGrid& grid(const Keyframe& k) {
+  /// k's grid on the device, uploaded when absent or changed. Evicts the least recently used grid
+  /// beyond kCapacity, never one the current batch reads (the cache then holds more for a while).
+  const detail::DeviceGrid* grid(const Keyframe& k) {
     const std::uint64_t sig = signature(k);
     auto found = grids.find(k.id);
     if (found != grids.end() && found->second.signature != sig) {
+      if (found->second.last_use == batch_clock)
+        throw std::logic_error("cuda::DensePointToPlane: two different grids with keyframe id " + std::to_string(k.id) +
+                               " in one graph");
       detail::releaseGrid(found->second.grid);
       grids.erase(found);
       found = grids.end();
     }
     if (found == grids.end()) {
       if (grids.size() >= kCapacity) {
-        auto oldest = grids.begin();
+        auto oldest = grids.end();
         for (auto it = grids.begin(); it != grids.end(); ++it)
-          if (it->second.last_use < oldest->second.last_use) oldest = it;
-        detail::releaseGrid(oldest->second.grid);
-        grids.erase(oldest);
+          if (it->second.last_use < batch_clock && (oldest == grids.end() || it->second.last_use < oldest->second.last_use))
+            oldest = it;
+        if (oldest != grids.end()) {
+          detail::releaseGrid(oldest->second.grid);
+          grids.erase(oldest);
+        }
       }
       const cv::Mat points = k.points.isContinuous() ? k.points : k.points.clone();
       const cv::Mat normals = k.normals.isContinuous() ? k.normals : k.normals.clone();
@@ -74,30 +86,40 @@ struct DensePointToPlane::Workspace {
                                         sig, 0})
                   .first;
     }
-    found->second.last_use = ++clock;
-    return *found->second.grid;
+    found->second.last_use = batch_clock;
+    return found->second.grid;
   }
 };
 
 DensePointToPlane::DensePointToPlane() : workspace_(std::make_shared<Workspace>()) {}
 
-void DensePointToPlane::lineariseWith(const PairInput& in, const LossParameters& loss, double weight,
-                                      PairSystem& system) const {
+void DensePointToPlane::lineariseAllWith(std::span<const PairInput> inputs, const LossParameters& loss, double weight,
+                                         std::span<PairSystem> systems) const {
+  if (systems.size() != inputs.size())
+    throw std::invalid_argument("cuda::DensePointToPlane::lineariseAll: " + std::to_string(inputs.size()) +
+                                " edges but " + std::to_string(systems.size()) + " systems");
   Workspace& w = *workspace_;
   const std::lock_guard lock(w.mutex);
-  const detail::DeviceGrid& grid_i = w.grid(in.i);
-  const detail::DeviceGrid& grid_j = w.grid(in.j);
-  const auto pass = [&](const detail::DeviceGrid& s, const detail::DeviceGrid& t, const SE3d& T_s, const SE3d& T_t,
-                        bool swapped) {
-    const detail::DirectedPass p = detail::directedPass(T_s, T_t, in.grid_camera, max_distance, max_normal_angle_deg,
-                                                        loss, weight);
-    double sums[detail::kDenseSums];
-    detail::accumulateDense(*w.sums, s, t, p, sums);
-    detail::addPassSums(sums, swapped, system);
-  };
-  pass(grid_i, grid_j, in.T_i, in.T_j, false);
-  pass(grid_j, grid_i, in.T_j, in.T_i, true);
-  system.finish();
+  ++w.batch_clock;
+  // Passes 2e and 2e + 1 are edge e's directions i -> j and j -> i.
+  w.passes.clear();
+  for (const PairInput& in : inputs) {
+    const detail::DeviceGrid* grid_i = w.grid(in.i);
+    const detail::DeviceGrid* grid_j = w.grid(in.j);
+    w.passes.push_back({grid_i, grid_j,
+                        detail::directedPass(in.T_i, in.T_j, in.grid_camera, max_distance, max_normal_angle_deg, loss,
+                                             weight)});
+    w.passes.push_back({grid_j, grid_i,
+                        detail::directedPass(in.T_j, in.T_i, in.grid_camera, max_distance, max_normal_angle_deg, loss,
+                                             weight)});
+  }
+  w.sums.resize(w.passes.size() * detail::kDenseSums);
+  detail::accumulateDense(*w.batch, w.passes.data(), int(w.passes.size()), w.sums.data());
+  for (std::size_t e = 0; e < inputs.size(); ++e) {
+    detail::addPassSums(w.sums.data() + 2 * e * detail::kDenseSums, false, systems[e]);
+    detail::addPassSums(w.sums.data() + (2 * e + 1) * detail::kDenseSums, true, systems[e]);
+    systems[e].finish();
+  }
 }
 
 }  // namespace bundletrack::cuda

@@ -1,6 +1,7 @@
 #pragma once
 
 #include <concepts>
+#include <span>
 #include <vector>
 
 #include <Eigen/Core>
@@ -90,6 +91,14 @@ struct PairSystem {
 template <typename T>
 concept Residual = requires(const T& residual, const PairInput& input, const HuberLoss& loss, PairSystem& system) {
   { residual.linearise(input, loss, 1.0, system) } -> std::same_as<void>;
+};
+
+/// A residual that also linearises many edges in one call, systems[e] receiving what
+/// linearise(inputs[e], ...) would add (a GPU backend: one launch for every edge of the graph).
+template <typename T>
+concept BatchResidual = Residual<T> && requires(const T& residual, std::span<const PairInput> inputs, const HuberLoss& loss,
+                                                std::span<PairSystem> systems) {
+  { residual.lineariseAll(inputs, loss, 1.0, systems) } -> std::same_as<void>;
 };
 
 }  // namespace bundletrack

@@ -28,9 +28,9 @@ struct OptimizationReport {
 };
 
 /// Assembles the normal equations of the free nodes (all but node 0) at the given poses: H (6k x
-/// 6k, k = nodes - 1) and b = J^T W r. Edges linearise independently (in parallel); the scatter is
-/// serial and ordered, so the result does not depend on the thread schedule. Returns the cost and
-/// writes the number of residuals.
+/// 6k, k = nodes - 1) and b = J^T W r. Edges linearise independently (in parallel, or all in one
+/// call for an energy with lineariseAll); the scatter is serial and ordered, so the result does
+/// not depend on the thread schedule. Returns the cost and writes the number of residuals.
 template <PoseGraphEnergy EnergyT>
 double assembleNormalEquations(const EnergyT& energy, const std::vector<const Keyframe*>& nodes,
                                const std::vector<GraphEdge>& edges, const PinholeCameraf& grid_camera,
@@ -40,13 +40,17 @@ double assembleNormalEquations(const EnergyT& energy, const std::vector<const Ke
   H.setZero(n, n);
   b.setZero(n);
   std::vector<PairSystem> pairs(edges.size());
-  cv::parallel_for_(cv::Range(0, int(edges.size())), [&](const cv::Range& range) {
-    for (int e = range.start; e < range.end; ++e) {
-      const GraphEdge& edge = edges[std::size_t(e)];
-      energy.linearise(PairInput{*nodes[edge.i], *nodes[edge.j], poses[edge.i], poses[edge.j], *edge.matches, grid_camera},
-                       pairs[std::size_t(e)]);
-    }
-  });
+  std::vector<PairInput> inputs;
+  inputs.reserve(edges.size());
+  for (const GraphEdge& edge : edges)
+    inputs.push_back({*nodes[edge.i], *nodes[edge.j], poses[edge.i], poses[edge.j], *edge.matches, grid_camera});
+  if constexpr (requires { energy.lineariseAll(std::span<const PairInput>(inputs), std::span<PairSystem>(pairs)); }) {
+    energy.lineariseAll(inputs, pairs);
+  } else {
+    cv::parallel_for_(cv::Range(0, int(edges.size())), [&](const cv::Range& range) {
+      for (int e = range.start; e < range.end; ++e) energy.linearise(inputs[std::size_t(e)], pairs[std::size_t(e)]);
+    });
+  }
   double cost = 0.0;
   residuals = 0;
   for (std::size_t e = 0; e < edges.size(); ++e) {

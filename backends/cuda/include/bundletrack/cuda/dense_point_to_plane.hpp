@@ -1,6 +1,7 @@
 #pragma once
 
 #include <memory>
+#include <span>
 #include <type_traits>
 
 #include "bundletrack/residuals/pair_system.hpp"
@@ -23,10 +24,11 @@ LossParameters lossParameters(const Loss& loss) {
 }
 
 /// The dense point-to-plane term (paper eq. 3) on the GPU: the association, gates, residual and
-/// Jacobian of bundletrack::DensePointToPlane, one kernel per direction of an edge, robust weights
-/// and the edge's normal equations accumulated in double on the device. Keyframe grids are
-/// uploaded once and stay on the device while they are in use (the 64 most recently used).
-/// Satisfies Residual, so Energy<..., Term<cuda::DensePointToPlane, HuberLoss>> composes.
+/// Jacobian of bundletrack::DensePointToPlane, robust weights and each edge's normal equations
+/// accumulated in double on the device. lineariseAll() does every direction of every edge of a
+/// graph in one kernel launch (Energy and Gauss-Newton call it once per iteration). Keyframe grids
+/// are uploaded once and stay on the device while they are in use (the 64 most recently used).
+/// Satisfies BatchResidual, so Energy<..., Term<cuda::DensePointToPlane, HuberLoss>> composes.
 class DensePointToPlane {
  public:
   float max_distance = 0.02f;  ///< metres (original code: 2 cm)
@@ -36,11 +38,19 @@ class DensePointToPlane {
 
   template <RobustLoss Loss>
   void linearise(const PairInput& in, const Loss& loss, double weight, PairSystem& system) const {
-    lineariseWith(in, lossParameters(loss), weight, system);
+    lineariseAllWith(std::span(&in, 1), lossParameters(loss), weight, std::span(&system, 1));
+  }
+
+  /// systems[e] += the residuals of edge inputs[e], for all edges in one launch.
+  template <RobustLoss Loss>
+  void lineariseAll(std::span<const PairInput> inputs, const Loss& loss, double weight,
+                    std::span<PairSystem> systems) const {
+    lineariseAllWith(inputs, lossParameters(loss), weight, systems);
   }
 
  private:
-  void lineariseWith(const PairInput& in, const LossParameters& loss, double weight, PairSystem& system) const;
+  void lineariseAllWith(std::span<const PairInput> inputs, const LossParameters& loss, double weight,
+                        std::span<PairSystem> systems) const;
 
   struct Workspace;
   std::shared_ptr<Workspace> workspace_;
