@@ -1,5 +1,5 @@
-// bench_tracker [--sequence DIR ...] [--frames N] [--memory-every N] [--gpu]
-// Runs the default tracker on each sequence (or on a synthetic one rendered in memory) and prints,
+// bench_tracker [--sequence DIR ...] [--frames N] [--memory-every N] [--features F] [--gpu]
+// Runs the default tracker (with --features orb|akaze: that detector instead of SIFT) on each sequence (or on a synthetic one rendered in memory) and prints,
 // per stage, the median and 90th percentile of the milliseconds per frame, the share of the
 // median frame, and frames per second (tracking only, and with reading + preprocessing).
 // --memory-every N also prints, every N frames, the keyframes in the pool and the process's
@@ -105,31 +105,42 @@ void compare(const Stages& cpu, const Stages& gpu) {
 struct Options {
   std::vector<std::string> sequences;
   int frames = 150, memory_every = 0;
+  std::string features = "sift";
   bool gpu = false;
 };
 
-/// The default tracker on the frames, and with --gpu the GPU-composed one as well.
-template <typename FrameAt>
+/// The default tracker with `Detector` on the frames, and with --gpu the GPU-composed one as well.
+template <typename Detector, typename FrameAt>
 void run(const std::string& name, const bt::PinholeCameraf& camera, std::size_t frames, const Options& options,
          FrameAt&& frame_at) {
-  const Stages cpu = track(bt::DefaultTracker(camera), frames, options.memory_every, frame_at);
-  report(name, cpu);
+  const std::string detector = " [" + options.features + "]";
+  const Stages cpu = track(bt::Tracker<bt::DefaultEnergy, bt::PCG, Detector>(camera), frames, options.memory_every, frame_at);
+  report(name + detector, cpu);
   if (!options.gpu) return;
 #ifdef BUNDLETRACK_HAS_CUDA
   using GpuEnergy = bt::Energy<bt::Term<bt::FeaturePointToPoint, bt::HuberLoss>, bt::Term<bt::cuda::DensePointToPlane, bt::HuberLoss>>;
-  using GpuTracker =
-      bt::Tracker<GpuEnergy, bt::cuda::PCG, bt::cuda::GpuMatched<bt::SiftFeatures>, bt::GivenMasks, bt::cuda::Ransac>;
+  using GpuTracker = bt::Tracker<GpuEnergy, bt::cuda::PCG, bt::cuda::GpuMatched<Detector>, bt::GivenMasks, bt::cuda::Ransac>;
   const Stages gpu = track(GpuTracker(camera), frames, 0, frame_at);
-  report(name + " (GPU policies: cuda::PCG, cuda::GpuMatched<SiftFeatures>, cuda::DensePointToPlane, cuda::Ransac)", gpu);
+  report(name + detector + " (GPU policies: cuda::PCG, cuda::GpuMatched, cuda::DensePointToPlane, cuda::Ransac)", gpu);
   compare(cpu, gpu);
 #endif
+}
+
+/// run() with the detector --features names.
+template <typename FrameAt>
+void runWithDetector(const std::string& name, const bt::PinholeCameraf& camera, std::size_t frames,
+                     const Options& options, FrameAt&& frame_at) {
+  if (options.features == "orb") run<bt::OrbFeatures>(name, camera, frames, options, frame_at);
+  else if (options.features == "akaze") run<bt::AkazeFeatures>(name, camera, frames, options, frame_at);
+  else run<bt::SiftFeatures>(name, camera, frames, options, frame_at);
 }
 
 }  // namespace
 
 int main(int argc, char** argv) {
   Options options;
-  const char* const usage = "usage: bench_tracker [--sequence DIR ...] [--frames N] [--memory-every N] [--gpu]\n";
+  const char* const usage =
+      "usage: bench_tracker [--sequence DIR ...] [--frames N] [--memory-every N] [--features sift|orb|akaze] [--gpu]\n";
   for (int i = 1; i < argc; ++i) {
     const std::string arg = argv[i];
     if (arg == "--gpu") {
@@ -143,10 +154,15 @@ int main(int argc, char** argv) {
     if (arg == "--sequence") options.sequences.emplace_back(argv[++i]);
     else if (arg == "--frames") options.frames = std::atoi(argv[++i]);
     else if (arg == "--memory-every") options.memory_every = std::atoi(argv[++i]);
+    else if (arg == "--features") options.features = argv[++i];
     else {
       std::fprintf(stderr, "unknown option '%s'\n%s", arg.c_str(), usage);
       return 2;
     }
+  }
+  if (options.features != "sift" && options.features != "orb" && options.features != "akaze") {
+    std::fprintf(stderr, "error: --features: '%s' is not sift, orb or akaze\n%s", options.features.c_str(), usage);
+    return 2;
   }
 #ifdef BUNDLETRACK_HAS_CUDA
   if (options.gpu && !bt::cuda::deviceAvailable()) {
@@ -166,7 +182,7 @@ int main(int argc, char** argv) {
       settings.frames = frames;
       const bt::synth::SyntheticScene scene(settings);
       const auto camera = settings.camera.cast<float>();
-      run("synthetic hand-held box (rendering counted as reading)", camera, std::size_t(frames), options,
+      runWithDetector("synthetic hand-held box (rendering counted as reading)", camera, std::size_t(frames), options,
           [&](std::size_t i) {
             const auto f = scene.frame(int(i));
             return std::pair(bt::makeFrame(std::to_string(i), f.color, f.depth, f.mask, camera), f.T_cam_obj);
@@ -174,7 +190,7 @@ int main(int argc, char** argv) {
     }
     for (const auto& dir : options.sequences) {
       const bt::io::YcbineoatSequence sequence(dir);
-      run(dir, sequence.camera().cast<float>(), sequence.size(), options, [&](std::size_t i) {
+      runWithDetector(dir, sequence.camera().cast<float>(), sequence.size(), options, [&](std::size_t i) {
         return std::pair(sequence.frame(i), sequence.hasGroundTruth() ? sequence.groundTruthPose(i) : bt::SE3d());
       });
     }

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Regenerates bench/RESULTS.md from a fresh run of the benchmarks (build first; see README).
-# Usage: bash bench/make_results.sh [build-dir]   (about 12 minutes on 2 cores: the 3,000-frame
+# Usage: bash bench/make_results.sh [build-dir]   (about 13 minutes on 2 cores: the 3,000-frame
 # memory run takes half of it, the Open3D peers a third; the peers need python3-open3d)
 set -euo pipefail
 build=${1:-build}
@@ -86,18 +86,31 @@ depth=$("$build/bin/bench_depth_processing" --benchmark_format=csv 2>/dev/null)
   "$build/bin/bench_tracker" --frames 150
   [ ${#args[@]} -gt 0 ] && "$build/bin/bench_tracker" "${args[@]}"
   echo '```'
+  echo
+  echo "## Tracker per stage with ORB keypoints (bench_tracker --features orb)"
+  echo
+  echo "The same tracker with OpenCV's ORB instead of SIFT on the same frames (features.type: orb);"
+  echo "keypoint detection is the stage that changes."
+  echo
+  echo '```'
+  "$build/bin/bench_tracker" --features orb --frames 150
+  [ ${#args[@]} -gt 0 ] && "$build/bin/bench_tracker" --features orb "${args[@]}"
+  echo '```'
   if command -v nvidia-smi > /dev/null && nvidia-smi -L > /dev/null 2>&1 && "$build/bin/bench_tracker" --gpu --frames 2 > /dev/null 2>&1; then
     echo
     echo "## CPU and GPU policies side by side (bench_tracker --gpu)"
     echo
     echo "GPU: $(nvidia-smi --query-gpu=name --format=csv,noheader | head -1). Default tracker against"
-    echo "Tracker<FeaturePointToPoint + cuda::DensePointToPlane, cuda::PCG, cuda::GpuMatched<SiftFeatures>,"
+    echo "Tracker<FeaturePointToPoint + cuda::DensePointToPlane, cuda::PCG, cuda::GpuMatched<Detector>,"
     echo "GivenMasks, cuda::Ransac>"
-    echo "on the same frames, same run; medians in ms per frame (absolute: this is the GPU machine)."
+    echo "on the same frames, same run, with SIFT and with ORB keypoints (detected on the CPU); medians"
+    echo "in ms per frame (absolute: this is the GPU machine)."
     echo
     echo '```'
-    "$build/bin/bench_tracker" --gpu --frames 150
-    [ ${#args[@]} -gt 0 ] && "$build/bin/bench_tracker" --gpu "${args[@]}"
+    for features in sift orb; do
+      "$build/bin/bench_tracker" --gpu --features "$features" --frames 150
+      [ ${#args[@]} -gt 0 ] && "$build/bin/bench_tracker" --gpu --features "$features" "${args[@]}"
+    done
     echo '```'
   fi
   echo
