@@ -19,6 +19,12 @@
 
 #include <opencv2/videoio.hpp>
 #include "bundletrack/tracker.hpp"
+#ifdef BUNDLETRACK_HAS_CUDA
+#include "bundletrack/cuda/dense_point_to_plane.hpp"
+#include "bundletrack/cuda/matching.hpp"
+#include "bundletrack/cuda/pcg.hpp"
+#include "bundletrack/cuda/ransac.hpp"
+#endif
 
 namespace bt = bundletrack;
 namespace fs = std::filesystem;
@@ -33,6 +39,8 @@ const char* const kUsage = R"(usage: bundletrack_track --sequence DIR --out DIR 
   --depth-scale S    metres per unit of the depth images (0.001)
   --min-inliers N    fewest RANSAC inliers that count as a pose; fewer: the frame is lost (5)
   --inlier-mm D      RANSAC inlier distance in millimetres (5)
+  --gpu              matching, dense term, PCG and RANSAC on a CUDA device (compute.device: gpu;
+                     needs a build with the CUDA backend and a GPU; keypoints stay on the CPU)
   --propagate-masks  the tracker gets only the first frame's mask and follows the object from it
                      (masks.source: propagated); later masks, where the sequence has them, are
                      read only to report each propagated mask's IoU in track.csv and a summary;
@@ -198,17 +206,39 @@ int run(Tracker tracker, const bt::io::YcbineoatSequence& sequence, const Option
   return 0;
 }
 
+/// The full tracker with the GPU policies of bundletrack::cuda (compute.device: gpu).
+template <typename Source, typename Masks>
+int runOnGpu(const Options& options, const bt::io::YcbineoatSequence& sequence, Source source,
+             const bt::MatchSettings& matching, Masks masks) {
+#ifdef BUNDLETRACK_HAS_CUDA
+  if (!bt::cuda::deviceAvailable())
+    throw std::runtime_error("compute.device is gpu, but no CUDA device is available (is the NVIDIA driver loaded?)");
+  using GpuEnergy = bt::Energy<bt::Term<bt::FeaturePointToPoint, bt::HuberLoss>, bt::Term<bt::cuda::DensePointToPlane, bt::HuberLoss>>;
+  using Tracker = bt::Tracker<GpuEnergy, bt::cuda::PCG, bt::cuda::GpuMatched<Source>, Masks, bt::cuda::Ransac>;
+  return run(Tracker(sequence.camera().cast<float>(), options.config.tracker, {}, {},
+                     bt::cuda::GpuMatched<Source>(std::move(source), matching), std::move(masks)),
+             sequence, options);
+#else
+  (void)options, (void)sequence, (void)source, (void)matching, (void)masks;
+  throw std::runtime_error("compute.device is gpu, but this build has no CUDA backend (configure with "
+                           "-DBUNDLETRACK_CUDA=ON on a machine with nvcc)");
+#endif
+}
+
 template <typename Source>
 int runWith(const Options& options, const typename Source::Settings& source_settings) {
   const bt::io::YcbineoatSequence sequence(options.sequence, options.config.sequence);
   const bt::TrackerSettings& settings = options.config.tracker;
   if (options.tracker == "coarse") return run(bt::CoarseTracker<Source>(Source(source_settings), settings.coarse), sequence, options);
   const bt::PinholeCameraf camera = sequence.camera().cast<float>();
+  const bool gpu = options.config.device == "gpu";
   if (options.config.masks == "propagated") {
+    bt::PropagatedMasks masks(options.config.propagated_masks);
+    if (gpu) return runOnGpu(options, sequence, Source(source_settings), source_settings.matching, std::move(masks));
     using Tracker = bt::Tracker<bt::DefaultEnergy, bt::PCG, Source, bt::PropagatedMasks>;
-    return run(Tracker(camera, settings, {}, {}, Source(source_settings), bt::PropagatedMasks(options.config.propagated_masks)),
-               sequence, options);
+    return run(Tracker(camera, settings, {}, {}, Source(source_settings), std::move(masks)), sequence, options);
   }
+  if (gpu) return runOnGpu(options, sequence, Source(source_settings), source_settings.matching, bt::GivenMasks());
   using Tracker = bt::Tracker<bt::DefaultEnergy, bt::PCG, Source>;
   return run(Tracker(camera, settings, {}, {}, Source(source_settings)), sequence, options);
 }
@@ -232,7 +262,7 @@ int main(int argc, char** argv) {
     else if (arg == "--print-config") print_config = true;
     else if (arg == "--features" || arg == "--depth-scale" || arg == "--min-inliers" || arg == "--inlier-mm")
       overrides.emplace_back(arg, value());
-    else if (arg == "--propagate-masks") overrides.emplace_back(arg, "");
+    else if (arg == "--propagate-masks" || arg == "--gpu") overrides.emplace_back(arg, "");
     else if (arg == "--quiet") options.quiet = true;
     else if (arg == "--viz") options.viz = true;
     else if (arg == "--help" || arg == "-h") {
@@ -249,6 +279,7 @@ int main(int argc, char** argv) {
       else if (option == "--min-inliers") config.tracker.coarse.min_inliers = int(number(option, text));
       else if (option == "--inlier-mm") config.tracker.coarse.ransac.inlier_distance = float(number(option, text) * 1e-3);
       else if (option == "--propagate-masks") config.masks = "propagated";
+      else if (option == "--gpu") config.device = "gpu";
     }
     if (print_config) {
       std::cout << bt::io::printConfig(config);
@@ -258,6 +289,8 @@ int main(int argc, char** argv) {
     if (options.tracker != "coarse" && options.tracker != "full") fail("unknown tracker '" + options.tracker + "'");
     if (options.tracker == "coarse" && config.masks == "propagated")
       fail("propagated masks need the full tracker (they render its keyframes)");
+    if (options.tracker == "coarse" && config.device == "gpu")
+      fail("the GPU policies serve the full tracker; the coarse tracker runs on the CPU");
     if (config.features == "sift") return runWith<bt::SiftFeatures>(options, config.sift);
     if (config.features == "orb") return runWith<bt::OrbFeatures>(options, config.orb);
     if (config.features == "akaze") return runWith<bt::AkazeFeatures>(options, config.akaze);

@@ -25,7 +25,8 @@ TEST_CASE("configuration values land in the settings they name, and printing rea
                               "depth:\n  scale: 0.0001\n  max_depth: 2.5\n"
                               "features:\n  type: orb\n  max_keypoints: 300\n"
                               "ransac:\n  inlier_distance: 0.01\n"
-                              "masks:\n  source: propagated\n  growth_px: 12\n");
+                              "masks:\n  source: propagated\n  growth_px: 12\n"
+                              "compute:\n  device: gpu\n");
   const bt::io::Config config = bt::io::loadConfig(path);
   CHECK(config.tracker.max_keyframes == 7);
   CHECK(config.tracker.edge_gate_distance == doctest::Approx(0.03f));
@@ -36,8 +37,11 @@ TEST_CASE("configuration values land in the settings they name, and printing rea
   CHECK(config.tracker.coarse.ransac.inlier_distance == doctest::Approx(0.01f));
   CHECK(config.masks == "propagated");
   CHECK(config.propagated_masks.growth_px == 12);
+  CHECK(config.device == "gpu");  // a section of choices alone
   CHECK(config.tracker.new_keyframe_rotation_deg == 10.0);  // untouched keys keep their defaults
   const std::string printed = bt::io::printConfig(config);
+  CHECK(printed.find("compute:\n") != std::string::npos);
+  CHECK(printed.find("  device: gpu\n") != std::string::npos);
   const bt::io::Config again = bt::io::loadConfig(writeFile(dir, "b.yaml", printed));
   CHECK(bt::io::printConfig(again) == printed);
   CHECK(bt::io::printConfig(bt::io::loadConfig(writeFile(dir, "empty.yaml", ""))) == bt::io::printConfig({}));
@@ -65,6 +69,7 @@ TEST_CASE("bad configuration files name the file and the key") {
   expect("ransac:\n  max_trials: many\n", "must be a number");
   expect("features:\n  type: surf\n", "expected sift | orb | akaze");
   expect("masks:\n  source: network\n", "masks.source = 'network': expected given | propagated");
+  expect("compute:\n  device: tpu\n", "compute.device = 'tpu': expected cpu | gpu");
   expect("graph: [1, 2\n", "not valid YAML");
   expect("graph: 3\n", "must be a section");
   try {

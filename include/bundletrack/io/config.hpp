@@ -32,6 +32,7 @@ struct Config {
   TrackerSettings tracker;
   std::string masks = "given";  ///< given: every frame's mask from the data | propagated: the first one only
   PropagatedMaskSettings propagated_masks;
+  std::string device = "cpu";  ///< cpu: the header-only policies | gpu: those of bundletrack::cuda
 };
 
 /// A setting chosen by name: section.key, where it lives, and the names it accepts.
@@ -46,7 +47,10 @@ struct ConfigChoice {
 inline std::vector<ConfigChoice> configChoices(Config& c) {
   return {{"features", "type", &c.features, {"sift", "orb", "akaze"}, "keypoint detector and descriptor"},
           {"masks", "source", &c.masks, {"given", "propagated"},
-           "given: every frame's mask from the data; propagated: from the first mask alone"}};
+           "given: every frame's mask from the data; propagated: from the first mask alone"},
+          {"compute", "device", &c.device, {"cpu", "gpu"},
+           "cpu: header-only policies; gpu: matching, dense term, PCG and RANSAC on a CUDA device "
+           "(bundletrack::cuda; keypoints are still detected on the CPU)"}};
 }
 
 /// One entry of the YAML file: section.key, where it lives, its valid range, unit and meaning.
@@ -179,17 +183,22 @@ inline Config loadConfig(const std::filesystem::path& path) {
 /// its meaning and unit (OpenCV's YAML reader keeps a comment after a string value as part of it).
 inline std::string printConfig(Config config) {
   std::ostringstream out;
+  const auto printChoices = [&](const std::string& section) {
+    for (const ConfigChoice& c : configChoices(config)) {
+      if (section != c.section) continue;
+      std::string names;
+      for (const std::string& n : c.names) names += (names.empty() ? "" : " | ") + n;
+      out << "  # " << c.meaning << " (" << names << ")\n  " << c.key << ": " << *c.value << "\n";
+    }
+  };
+  std::vector<std::string> printed;
   std::string section;
   for (const ConfigParameter& p : configParameters(config)) {
     if (section != p.section) {
       section = p.section;
+      printed.push_back(section);
       out << section << ":\n";
-      for (const ConfigChoice& c : configChoices(config)) {
-        if (section != c.section) continue;
-        std::string names;
-        for (const std::string& n : c.names) names += (names.empty() ? "" : " | ") + n;
-        out << "  # " << c.meaning << " (" << names << ")\n  " << c.key << ": " << *c.value << "\n";
-      }
+      printChoices(section);
     }
     out << "  # " << p.meaning << (*p.unit ? std::string(" [") + p.unit + "]" : "") << "\n  " << p.key << ": ";
     std::visit([&](auto* value) {
@@ -206,6 +215,12 @@ inline std::string printConfig(Config config) {
       }
     }, p.value);
     out << "\n";
+  }
+  for (const ConfigChoice& c : configChoices(config)) {  // sections of choices alone
+    if (std::find(printed.begin(), printed.end(), c.section) != printed.end()) continue;
+    printed.push_back(c.section);
+    out << c.section << ":\n";
+    printChoices(c.section);
   }
   return out.str();
 }
