@@ -13,7 +13,7 @@ namespace synth = bundletrack::synth;
 
 static_assert(bt::FeatureRegistration<bt::cuda::Ransac>, "the GPU RANSAC composes like the CPU one");
 
-TEST_CASE("GPU-scored RANSAC finds the CPU RANSAC's pose and inliers") {
+TEST_CASE("GPU RANSAC (trials drawn, fitted and scored on the GPU) finds the CPU RANSAC's pose and inliers") {
   if (!bt::cuda::deviceAvailable()) {
     MESSAGE("SKIPPED: no CUDA device");
     return;

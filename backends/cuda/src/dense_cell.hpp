@@ -4,8 +4,8 @@
 
 #include <cmath>
 
+#include "bundletrack/core/macros.hpp"
 #include "dense_device.hpp"
-#include "host_device.hpp"
 
 namespace bundletrack::cuda::detail {
 

@@ -5,7 +5,7 @@
 #include <cmath>
 #include <cstdint>
 
-#include "host_device.hpp"
+#include "bundletrack/core/macros.hpp"
 
 namespace bundletrack::cuda::detail {
 

@@ -1,7 +1,7 @@
 #pragma once
 
-// What the host hands the RANSAC kernel: matched pairs and hypotheses in the plain layout of
-// ransac_device.hpp.
+// What the host hands the RANSAC kernels and takes back: matched pairs in the plain layout of
+// ransac_device.hpp, and fits as poses.
 
 #include <vector>
 
@@ -23,14 +23,12 @@ inline void packPairs(const MatchedPoints& pairs, std::vector<float>& out) {
   }
 }
 
-/// 12 floats a hypothesis: row-major 3x4 [R | t].
-inline void packHypotheses(const std::vector<SE3f>& hypotheses, std::vector<float>& out) {
-  out.resize(12 * hypotheses.size());
-  for (std::size_t h = 0; h < hypotheses.size(); ++h) {
-    const Eigen::Matrix4f T = hypotheses[h].matrix();
-    for (int r = 0; r < 3; ++r)
-      for (int c = 0; c < 4; ++c) out[12 * h + std::size_t(4 * r + c)] = T(r, c);
-  }
+/// The pose of a row-major 3x4 [R | t].
+inline SE3d poseOf(const double T[12]) {
+  Eigen::Matrix3d R;
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c) R(r, c) = T[4 * r + c];
+  return SE3d(SO3d::fromMatrix(R), Eigen::Vector3d(T[3], T[7], T[11]));
 }
 
 }  // namespace bundletrack::cuda::detail

@@ -3,8 +3,8 @@
 #include <stdexcept>
 #include <string>
 
+#include "ransac_body.hpp"
 #include "ransac_device.hpp"
-#include "ransac_pair.hpp"
 
 namespace bundletrack::cuda::detail {
 
@@ -16,7 +16,19 @@ void check(cudaError_t status, const char* what) {
   if (status != cudaSuccess) throw std::runtime_error(std::string("CUDA ") + what + ": " + cudaGetErrorString(status));
 }
 
-/// One block per hypothesis: its threads test the pairs in strides and sum their counts.
+/// One thread per trial: its sample and fit.
+__global__ void trialKernel(const float* pairs, int n, TrialParameters parameters, int first, int count, double* fits,
+                            float* hypotheses, unsigned char* valid) {
+  const int b = blockIdx.x * blockDim.x + threadIdx.x;
+  if (b >= count) return;
+  valid[b] = fitTrial(pairs, n, parameters.seed, std::uint64_t(first + b), parameters.min_sample_spread, fits + 12 * b,
+                      hypotheses + 12 * b)
+                 ? 1
+                 : 0;
+}
+
+/// One block per trial: its threads test the pairs in strides and sum their counts; every count
+/// has its own slot, so blocks never race for the best hypothesis.
 __global__ void countKernel(const float* pairs, int n, const float* hypotheses, const unsigned char* valid,
                             float max_squared_distance, float cos_max_angle, int* counts) {
   __shared__ int partial[kThreads];
@@ -48,14 +60,15 @@ void grow(T*& buffer, int& capacity, int count) {
 
 struct RansacBuffers {
   float* pairs = nullptr;
+  double* fits = nullptr;
   float* hypotheses = nullptr;
   unsigned char* valid = nullptr;
   int* counts = nullptr;
-  int pair_floats = 0, hypothesis_floats = 0, valid_bytes = 0, count_ints = 0, n = 0;
+  int pair_floats = 0, fit_doubles = 0, hypothesis_floats = 0, valid_bytes = 0, count_ints = 0, n = 0;
 
   ~RansacBuffers() {
-    for (void* p : {static_cast<void*>(pairs), static_cast<void*>(hypotheses), static_cast<void*>(valid),
-                    static_cast<void*>(counts)})
+    for (void* p : {static_cast<void*>(pairs), static_cast<void*>(fits), static_cast<void*>(hypotheses),
+                    static_cast<void*>(valid), static_cast<void*>(counts)})
       if (p) cudaFree(p);
   }
 };
@@ -69,17 +82,22 @@ void uploadPairs(RansacBuffers& b, const float* pairs, int n) {
   b.n = n;
 }
 
-void countInliers(RansacBuffers& b, const float* hypotheses, const unsigned char* valid, int count,
-                  float max_squared_distance, float cos_max_angle, int* counts) {
+void scoreTrials(RansacBuffers& b, const TrialParameters& parameters, int first, int count, double* fits,
+                 unsigned char* valid, int* counts) {
   if (count <= 0) return;
+  if (b.n < 3) throw std::logic_error("GPU RANSAC: trials need at least 3 uploaded pairs");
+  grow(b.fits, b.fit_doubles, 12 * count);
   grow(b.hypotheses, b.hypothesis_floats, 12 * count);
   grow(b.valid, b.valid_bytes, count);
   grow(b.counts, b.count_ints, count);
-  check(cudaMemcpy(b.hypotheses, hypotheses, std::size_t(12 * count) * sizeof(float), cudaMemcpyHostToDevice),
-        "copy hypotheses");
-  check(cudaMemcpy(b.valid, valid, std::size_t(count), cudaMemcpyHostToDevice), "copy validity");
-  countKernel<<<count, kThreads>>>(b.pairs, b.n, b.hypotheses, b.valid, max_squared_distance, cos_max_angle, b.counts);
+  trialKernel<<<(count + kThreads - 1) / kThreads, kThreads>>>(b.pairs, b.n, parameters, first, count, b.fits,
+                                                               b.hypotheses, b.valid);
+  check(cudaGetLastError(), "trial kernel launch");
+  countKernel<<<count, kThreads>>>(b.pairs, b.n, b.hypotheses, b.valid, parameters.max_squared_distance,
+                                   parameters.cos_max_angle, b.counts);
   check(cudaGetLastError(), "inlier kernel launch");
+  check(cudaMemcpy(fits, b.fits, std::size_t(12 * count) * sizeof(double), cudaMemcpyDeviceToHost), "copy fits");
+  check(cudaMemcpy(valid, b.valid, std::size_t(count), cudaMemcpyDeviceToHost), "copy validity");
   check(cudaMemcpy(counts, b.counts, std::size_t(count) * sizeof(int), cudaMemcpyDeviceToHost), "copy counts");
 }
 

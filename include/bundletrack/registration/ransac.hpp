@@ -12,6 +12,7 @@
 
 #include "bundletrack/features/frame_features.hpp"
 #include "bundletrack/registration/kabsch.hpp"
+#include "bundletrack/registration/ransac_trial.hpp"
 
 namespace bundletrack {
 
@@ -36,18 +37,6 @@ struct RansacResult {
   double inlierRatio() const { return matches == 0 ? 0.0 : double(inliers.size()) / double(matches); }
 };
 
-namespace detail {
-
-/// SplitMix64: trial k's sample depends only on (seed, k), whatever the thread schedule.
-inline std::uint64_t splitmix64(std::uint64_t x) {
-  x += 0x9e3779b97f4a7c15ull;
-  x = (x ^ (x >> 30)) * 0xbf58476d1ce4e5b9ull;
-  x = (x ^ (x >> 27)) * 0x94d049bb133111ebull;
-  return x ^ (x >> 31);
-}
-
-}  // namespace detail
-
 /// The matched points of one RANSAC problem, side by side (pair k is match k).
 struct MatchedPoints {
   std::vector<Eigen::Vector3f> first, second, first_normals, second_normals;
@@ -61,6 +50,7 @@ struct MatchedPoints {
     }
   }
   std::size_t size() const { return first.size(); }
+  std::pair<const Eigen::Vector3f&, const Eigen::Vector3f&> pair(std::size_t k) const { return {first[k], second[k]}; }
 };
 
 /// Paper IV-B's inlier test: the moved point within inlier_distance and the moved normal within
@@ -79,27 +69,58 @@ struct InlierGate {
   }
 };
 
-/// Counts the inliers of a batch of hypotheses on the CPU (in parallel when asked). The part of
-/// RANSAC a backend may run elsewhere: prepare() sees the problem once, count() every batch;
-/// counts[h] = 0 where valid[h] is false.
-class CpuInlierCounter {
+/// Draws trial k's sample (trialSample), rejects it when two matches coincide or its triangle is
+/// near-collinear in either frame (wellSpread, min_sample_spread); false for a rejected sample.
+inline bool drawTrial(const MatchedPoints& pairs, const RansacSettings& settings, std::uint64_t trial, int sample[3]) {
+  if (!trialSample(settings.seed, trial, int(pairs.size()), sample)) return false;
+  for (const std::vector<Eigen::Vector3f>* points : {&pairs.first, &pairs.second}) {
+    const auto at = [&](int k) { return (*points)[std::size_t(sample[k])].data(); };
+    if (!wellSpread(at(0), at(1), at(2), settings.min_sample_spread)) return false;
+  }
+  return true;
+}
+
+/// The part of RANSAC a backend may run elsewhere: for trials first .. first + count - 1, draw the
+/// sample (drawTrial), fit it (the least-squares rigid fit of its three pairs) and count the
+/// fit's inliers. prepare() sees the problem once; score() fills fits[b], valid[b] (false for a
+/// rejected sample) and scores[b] (0 where not valid) for b < count.
+template <typename T>
+concept TrialScorer = requires(T& scorer, const MatchedPoints& pairs, const RansacSettings& settings,
+                               const InlierGate& gate, std::vector<SE3d>& fits, std::vector<char>& valid,
+                               std::vector<int>& scores) {
+  scorer.prepare(pairs);
+  scorer.score(pairs, settings, gate, 0, 1, fits, valid, scores);
+};
+
+/// Trials on the CPU: samples and kabsch fits one by one, inliers counted per hypothesis (in
+/// parallel when asked).
+class CpuTrialScorer {
  public:
-  explicit CpuInlierCounter(bool parallel = true) : parallel_(parallel) {}
+  explicit CpuTrialScorer(bool parallel = true) : parallel_(parallel) {}
 
   void prepare(const MatchedPoints&) {}
 
-  void count(const MatchedPoints& pairs, const std::vector<SE3f>& hypotheses, const std::vector<char>& valid,
-             const InlierGate& gate, std::vector<int>& counts) const {
+  void score(const MatchedPoints& pairs, const RansacSettings& settings, const InlierGate& gate, int first, int count,
+             std::vector<SE3d>& fits, std::vector<char>& valid, std::vector<int>& scores) const {
+    fits.resize(std::size_t(count)), valid.resize(std::size_t(count)), scores.resize(std::size_t(count));
+    std::vector<SE3f> hypotheses(static_cast<std::size_t>(count));
+    for (int b = 0; b < count; ++b) {
+      int sample[3];
+      valid[std::size_t(b)] = drawTrial(pairs, settings, std::uint64_t(first + b), sample);
+      if (!valid[std::size_t(b)]) continue;
+      fits[std::size_t(b)] = kabsch(3, [&](std::size_t k) { return pairs.pair(std::size_t(sample[k])); });
+      hypotheses[std::size_t(b)] = fits[std::size_t(b)].cast<float>();
+    }
     const auto body = [&](const cv::Range& range) {
       for (int h = range.start; h < range.end; ++h) {
-        counts[std::size_t(h)] = 0;
+        scores[std::size_t(h)] = 0;
         if (!valid[std::size_t(h)]) continue;
         const SE3f& T = hypotheses[std::size_t(h)];
         const Eigen::Matrix3f R = T.rotationMatrix();
-        for (std::size_t k = 0; k < pairs.size(); ++k) counts[std::size_t(h)] += gate.admits(pairs, k, T, R);
+        for (std::size_t k = 0; k < pairs.size(); ++k) scores[std::size_t(h)] += gate.admits(pairs, k, T, R);
       }
     };
-    const cv::Range all(0, int(hypotheses.size()));
+    const cv::Range all(0, count);
     if (parallel_) cv::parallel_for_(all, body);
     else body(all);
   }
@@ -108,24 +129,17 @@ class CpuInlierCounter {
   bool parallel_;
 };
 
-template <typename T>
-concept InlierCounter = requires(T& counter, const MatchedPoints& pairs, const std::vector<SE3f>& hypotheses,
-                                 const std::vector<char>& valid, const InlierGate& gate, std::vector<int>& counts) {
-  counter.prepare(pairs);
-  counter.count(pairs, hypotheses, valid, gate, counts);
-};
-
 /// RANSAC over 3-D feature matches (paper IV-B): 3-point samples, closed-form fit (kabsch), a match
 /// is an inlier when the moved point lies within inlier_distance AND the moved normal within
 /// inlier_normal_angle_deg. The trial count adapts to the best inlier ratio w found so far,
 /// N = log(1 - confidence) / log(1 - w^3), capped at max_trials; ties go to the earliest trial, so
 /// the result is deterministic whatever counts the inliers. The winner is refitted on its inliers
 /// while the set grows.
-template <InlierCounter Counter>
+template <TrialScorer Scorer>
 class BasicRansac {
  public:
-  explicit BasicRansac(RansacSettings settings = {}, Counter counter = Counter())
-      : settings_(settings), counter_(std::move(counter)) {}
+  explicit BasicRansac(RansacSettings settings = {}, Scorer scorer = Scorer())
+      : settings_(settings), scorer_(std::move(scorer)) {}
   const RansacSettings& settings() const { return settings_; }
 
   RansacResult estimate(const FrameFeatures& first, const FrameFeatures& second,
@@ -135,27 +149,16 @@ class BasicRansac {
     if (matches.size() < 3) return result;
     const MatchedPoints pairs(first, second, matches);
     const InlierGate gate(settings_);
-    counter_.prepare(pairs);
+    scorer_.prepare(pairs);
     const int n = int(matches.size());
-    const std::size_t batch = std::size_t(settings_.batch);
-    std::vector<int> scores(batch);
-    std::vector<SE3f> hypotheses(batch);
-    std::vector<SE3d> fits(batch);
-    std::vector<char> valid(batch);
+    std::vector<SE3d> fits;
+    std::vector<char> valid;
+    std::vector<int> scores;
     int best_score = 0, needed = settings_.max_trials;
     SE3d best;
     for (int start = 0; start < std::min(needed, settings_.max_trials); start += settings_.batch) {
       const int count = std::min(settings_.batch, settings_.max_trials - start);
-      hypotheses.resize(std::size_t(count)), fits.resize(std::size_t(count)), valid.resize(std::size_t(count));
-      scores.resize(std::size_t(count));
-      for (int b = 0; b < count; ++b) {
-        int sample[3];
-        valid[std::size_t(b)] = drawSample(std::uint64_t(start + b), n, pairs, sample);
-        if (!valid[std::size_t(b)]) continue;
-        fits[std::size_t(b)] = kabsch(3, [&](std::size_t k) { return pairOf(pairs, sample[k]); });
-        hypotheses[std::size_t(b)] = fits[std::size_t(b)].cast<float>();
-      }
-      counter_.count(pairs, hypotheses, valid, gate, scores);
+      scorer_.score(pairs, settings_, gate, start, count, fits, valid, scores);
       for (int b = 0; b < count; ++b) {
         if (scores[std::size_t(b)] <= best_score) continue;
         best_score = scores[std::size_t(b)];
@@ -170,7 +173,7 @@ class BasicRansac {
     // the result is always the refit of the reported inliers.
     std::vector<int> inliers = inliersOf(pairs, gate, best);
     for (int refit = 0; refit < 5; ++refit) {
-      best = kabsch(inliers.size(), [&](std::size_t k) { return pairOf(pairs, inliers[k]); });
+      best = kabsch(inliers.size(), [&](std::size_t k) { return pairs.pair(std::size_t(inliers[k])); });
       std::vector<int> next = inliersOf(pairs, gate, best);
       if (next.size() < inliers.size() || next == inliers) break;
       inliers = std::move(next);
@@ -181,10 +184,6 @@ class BasicRansac {
   }
 
  private:
-  static std::pair<const Eigen::Vector3f&, const Eigen::Vector3f&> pairOf(const MatchedPoints& pairs, int k) {
-    return {pairs.first[std::size_t(k)], pairs.second[std::size_t(k)]};
-  }
-
   static std::vector<int> inliersOf(const MatchedPoints& pairs, const InlierGate& gate, const SE3d& T) {
     const SE3f Tf = T.cast<float>();
     const Eigen::Matrix3f R = Tf.rotationMatrix();
@@ -194,31 +193,14 @@ class BasicRansac {
     return inliers;
   }
 
-  bool drawSample(std::uint64_t trial, int n, const MatchedPoints& pairs, int sample[3]) const {
-    std::uint64_t state = detail::splitmix64(settings_.seed ^ detail::splitmix64(trial));
-    for (int k = 0; k < 3; ++k) {
-      state = detail::splitmix64(state);
-      sample[k] = int(state % std::uint64_t(n));
-    }
-    if (sample[0] == sample[1] || sample[0] == sample[2] || sample[1] == sample[2]) return false;
-    // Reject near-collinear samples in either frame: the smallest triangle height must exceed the spread.
-    for (const std::vector<Eigen::Vector3f>* points : {&pairs.first, &pairs.second}) {
-      const auto point = [&](int k) -> const Eigen::Vector3f& { return (*points)[std::size_t(sample[k])]; };
-      const Eigen::Vector3f ab = point(1) - point(0), ac = point(2) - point(0), bc = point(2) - point(1);
-      const float longest = std::max({ab.norm(), ac.norm(), bc.norm()});
-      if (longest <= 0.0f || ab.cross(ac).norm() / longest < settings_.min_sample_spread) return false;
-    }
-    return true;
-  }
-
   RansacSettings settings_;
-  mutable Counter counter_;  // a backend may keep device buffers between calls
+  mutable Scorer scorer_;  // a backend may keep device buffers between calls
 };
 
 /// RANSAC with the inliers counted on the CPU (in parallel unless settings.parallel is false).
-class Ransac : public BasicRansac<CpuInlierCounter> {
+class Ransac : public BasicRansac<CpuTrialScorer> {
  public:
-  explicit Ransac(RansacSettings settings = {}) : BasicRansac(settings, CpuInlierCounter(settings.parallel)) {}
+  explicit Ransac(RansacSettings settings = {}) : BasicRansac(settings, CpuTrialScorer(settings.parallel)) {}
 };
 
 /// What the tracker asks of its robust registration (Ransac, cuda::Ransac): built from the
