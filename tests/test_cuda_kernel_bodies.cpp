@@ -13,6 +13,7 @@
 #include "bundletrack/features/opencv_features.hpp"
 #include "bundletrack/registration/ransac.hpp"
 #include "bundletrack/residuals/dense_point_to_plane.hpp"
+#include "bundletrack/cuda/pcg.hpp"
 #include "bundletrack/solvers/pcg.hpp"
 #include "bundletrack/synth/synthetic_sequence.hpp"
 #include "dense_cell.hpp"
@@ -21,6 +22,7 @@
 #include "matching_metric.hpp"
 #include "pcg_host.hpp"
 #include "pcg_loop.hpp"
+#include "pose_graph_system.hpp"
 #include "ransac_body.hpp"
 #include "ransac_host.hpp"
 #include "rigid_fit.hpp"
@@ -225,43 +227,56 @@ TEST_CASE("GPU two-nearest kernel body on the host equals OpenCV's brute-force m
   });
 }
 
-TEST_CASE("GPU PCG loop on the host matches the CPU PCG and converges to the dense solution") {
-  // A pose-graph-shaped system: 8 nodes, dense symmetric positive definite coupling.
-  const int n = 48;
-  const std::size_t size = n;
-  std::mt19937 random(3);
-  std::normal_distribution<double> noise(0.0, 1.0);
-  Eigen::MatrixXd M(n, n);
-  for (int r = 0; r < n; ++r)
-    for (int c = 0; c < n; ++c) M(r, c) = noise(random);
-  const Eigen::MatrixXd H = M * M.transpose() / n + Eigen::MatrixXd::Identity(n, n);
-  Eigen::VectorXd rhs(n);
-  for (int r = 0; r < n; ++r) rhs[r] = noise(random);
-  std::vector<float> H_rows(size * size), block_inverse, b(size);
+namespace {
+
+struct HostSolve {
+  int iterations;
+  Eigen::VectorXd x;
+  float relative_residual;
+};
+
+/// cuda::PCG's solve with the kernel's loop run by one host thread: the same float data, packing
+/// and preconditioner.
+HostSolve pcgOnHost(const Eigen::MatrixXd& H, const Eigen::VectorXd& rhs, const bt::cuda::PCG& settings) {
+  const int n = int(H.rows());
+  const std::size_t size = static_cast<std::size_t>(n);
+  std::vector<float> H_rows(size * size), block_inverse, b(size), x(size), r(size), z(size), p(size), Hp(size);
   Eigen::Map<Eigen::Matrix<float, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>>(H_rows.data(), n, n) = H.cast<float>();
-  for (int r = 0; r < n; ++r) b[std::size_t(r)] = float(rhs[r]);
-  detail::blockJacobiInverse(H, 1e-9, block_inverse);
-  std::vector<float> x(size), r(size), z(size), p(size), Hp(size);
-  const auto solve = [&](int max_iterations, float tolerance, float* residual) {
-    const int iterations = detail::pcgIterations(detail::SerialTeam{}, H_rows.data(), block_inverse.data(), b.data(),
-                                                 x.data(), r.data(), z.data(), p.data(), Hp.data(), n, max_iterations,
-                                                 tolerance, residual);
-    return std::pair(iterations, Eigen::Map<const Eigen::VectorXf>(x.data(), n).cast<double>().eval());
-  };
-  // Five iterations, as in the tracker: the same iterate as the CPU PCG in double, up to float
-  // rounding (relative 1e-7 per operation on a system of condition number about 5).
-  bt::PCG cpu;
-  Eigen::VectorXd x_cpu;
-  const bt::SolveReport report = cpu.solve(H, rhs, x_cpu);
-  float residual = 0.0f;
-  const auto [iterations, x_five] = solve(cpu.max_iterations, float(cpu.tolerance), &residual);
-  CHECK(iterations == report.iterations);
-  CHECK((x_five - x_cpu).norm() <= 1e-4 * x_cpu.norm());
-  CHECK(double(residual) == doctest::Approx(report.relative_residual).epsilon(1e-3));
-  // Run to float precision: the dense solution (Eigen LDLT) within the stopping tolerance.
-  const Eigen::VectorXd dense = H.ldlt().solve(rhs);
-  const auto [converged_iterations, x_converged] = solve(200, 1e-6f, &residual);
-  CHECK(converged_iterations < 200);
-  CHECK(residual <= 1e-6f);
-  CHECK((x_converged - dense).norm() <= 1e-5 * dense.norm());
+  for (int k = 0; k < n; ++k) b[std::size_t(k)] = float(rhs[k]);
+  detail::blockJacobiInverse(H, settings.damping, block_inverse);
+  HostSolve solve{0, {}, 0.0f};
+  solve.iterations = detail::pcgIterations(detail::SerialTeam{}, H_rows.data(), block_inverse.data(), b.data(), x.data(),
+                                           r.data(), z.data(), p.data(), Hp.data(), n, settings.max_iterations,
+                                           float(settings.tolerance), &solve.relative_residual);
+  solve.x = Eigen::Map<const Eigen::VectorXf>(x.data(), n).cast<double>();
+  return solve;
+}
+
+}  // namespace
+
+TEST_CASE("GPU PCG loop on the host matches the CPU PCG and converges to the dense solution") {
+  // The systems and checks of the GPU test (test_cuda_pcg.cpp), with the kernel's loop on the host.
+  for (const int nodes : {2, 15, 64}) {
+    CAPTURE(nodes);
+    Eigen::MatrixXd H;
+    Eigen::VectorXd rhs, x_cpu;
+    poseGraphSystem(nodes, unsigned(nodes), 1e-3, H, rhs);
+    // The tracker's truncated solve: 5 iterations, against the CPU PCG stopping by the same rule
+    // (the GPU's tolerance).
+    const bt::cuda::PCG gpu;
+    bt::PCG cpu;
+    cpu.tolerance = gpu.tolerance;
+    const bt::SolveReport report = cpu.solve(H, rhs, x_cpu);
+    const HostSolve five = pcgOnHost(H, rhs, gpu);
+    CHECK(five.iterations == report.iterations);
+    CHECK((five.x - x_cpu).norm() <= 1e-4 * x_cpu.norm());
+    // Run to float precision: the dense solution within what a 1e-6 residual allows.
+    bt::cuda::PCG converged;
+    converged.max_iterations = 2000;
+    const HostSolve full = pcgOnHost(H, rhs, converged);
+    const Eigen::VectorXd dense = H.ldlt().solve(rhs);
+    CHECK(full.iterations < 2000);
+    CHECK(full.relative_residual < 1e-5f);
+    CHECK((full.x - dense).norm() <= 1e-3 * dense.norm());
+  }
 }

@@ -42,6 +42,8 @@ TEST_CASE("GPU RANSAC (trials drawn, fitted and scored on the GPU) finds the CPU
     CHECK(std::abs(int(on_gpu.inliers.size()) - int(cpu.inliers.size())) <= 2);
     CHECK(bt::rotationErrorDeg(cpu.T_second_first, on_gpu.T_second_first) < 0.01);
     CHECK(bt::translationError(cpu.T_second_first, on_gpu.T_second_first) < 1e-4);
-    if (on_gpu.inliers.size() == cpu.inliers.size()) CHECK(on_gpu.trials == cpu.trials);
+    // Same samples, so the adaptive stop comes in the same batch unless a flipped match changed
+    // the best count on the way.
+    if (on_gpu.inliers.size() == cpu.inliers.size()) CHECK(std::abs(on_gpu.trials - cpu.trials) <= 64);
   }
 }
