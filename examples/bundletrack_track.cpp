@@ -122,6 +122,11 @@ class OverlayWriter {
   std::vector<cv::Mat> strip_;
 };
 
+double median(std::vector<double> values) {
+  std::nth_element(values.begin(), values.begin() + std::ptrdiff_t(values.size() / 2), values.end());
+  return values[values.size() / 2];
+}
+
 template <typename Tracker>
 int run(Tracker tracker, const bt::io::YcbineoatSequence& sequence, const Options& options) {
   fs::create_directories(options.out / "poses");
@@ -136,7 +141,7 @@ int run(Tracker tracker, const bt::io::YcbineoatSequence& sequence, const Option
   const bool interactive = isatty(fileno(stderr));
   std::optional<OverlayWriter> overlay;
   if (options.viz) overlay.emplace(options.out, sequence);
-  std::vector<double> rotation_errors, translation_errors, mask_ious;
+  std::vector<double> rotation_errors, translation_errors, mask_ious, total_ms, read_ms_all, features_ms;
   for (std::size_t i = 0; i < sequence.size(); ++i) {
     bt::Stopwatch reading;
     bt::RgbdFrame frame = sequence.frame(i);
@@ -152,6 +157,7 @@ int run(Tracker tracker, const bt::io::YcbineoatSequence& sequence, const Option
     lost += result.status == bt::TrackStatus::Lost;
     bt::io::writePose(options.out / "poses" / (frame.name + ".txt"), result.T_cam_obj);
     const auto& t = result.timings;
+    if (i > 0) total_ms.push_back(t.total), read_ms_all.push_back(read_ms), features_ms.push_back(t.features);
     csv << frame.name << ',' << bt::statusName(result.status) << ',' << result.keypoints << ',' << result.matches << ','
         << result.inliers << ',' << read_ms << ',' << t.mask << ',' << t.features << ',' << t.matching << ',' << t.ransac << ',' << t.graph
         << ',' << t.solve << ',' << t.total;
@@ -183,6 +189,12 @@ int run(Tracker tracker, const bt::io::YcbineoatSequence& sequence, const Option
   if (!options.quiet && interactive) std::fprintf(stderr, "\n");
   std::printf("%s: %zu frames, %d lost; poses in %s\n", options.sequence.string().c_str(), sequence.size(), lost,
               (options.out / "poses").string().c_str());
+  if (!total_ms.empty()) {
+    const double tracking = median(total_ms);
+    std::printf("median per frame: %.1f ms tracking (%.1f fps; keypoint detection %.1f ms of it), %.1f ms reading "
+                "and preprocessing; per stage in track.csv\n",
+                tracking, 1000.0 / tracking, median(features_ms), median(read_ms_all));
+  }
   if (!mask_ious.empty()) {
     double sum = 0.0;
     for (const double iou : mask_ious) sum += iou;
