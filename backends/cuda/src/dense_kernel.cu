@@ -1,21 +1,15 @@
-#include <cuda_runtime.h>
-
 #include <algorithm>
 #include <stdexcept>
-#include <string>
 #include <vector>
 
 #include "dense_cell.hpp"
+#include "device_memory.hpp"
 
 namespace bundletrack::cuda::detail {
 
 namespace {
 
 constexpr int kThreads = 128;
-
-void check(cudaError_t status, const char* what) {
-  if (status != cudaSuccess) throw std::runtime_error(std::string("CUDA ") + what + ": " + cudaGetErrorString(status));
-}
 
 /// A pass as the kernel reads it: the grids' device pointers and the pass parameters.
 struct KernelPass {
@@ -44,14 +38,6 @@ __global__ void denseKernel(const KernelPass* passes, double* sums) {
     for (int offset = 16; offset > 0; offset /= 2) value += __shfl_down_sync(0xffffffffu, value, offset);
     if ((threadIdx.x & 31) == 0 && value != 0.0) atomicAdd(out + i, value);
   }
-}
-
-template <typename T>
-void grow(T*& buffer, std::size_t& capacity, std::size_t count) {
-  if (count <= capacity) return;
-  if (buffer) check(cudaFree(buffer), "free");
-  check(cudaMalloc(&buffer, count * sizeof(T)), "malloc");
-  capacity = count;
 }
 
 }  // namespace

@@ -1,9 +1,8 @@
-#include <cuda_runtime.h>
-
 #include <cmath>
 #include <stdexcept>
 #include <string>
 
+#include "device_memory.hpp"
 #include "matching_device.hpp"
 #include "matching_metric.hpp"
 
@@ -14,10 +13,6 @@ namespace {
 constexpr int kThreads = 128;  ///< query rows per block
 constexpr int kTile = 32;  ///< train rows staged in shared memory at a time
 constexpr int kMaxSharedBytes = 48 * 1024;
-
-void check(cudaError_t status, const char* what) {
-  if (status != cudaSuccess) throw std::runtime_error(std::string("CUDA ") + what + ": " + cudaGetErrorString(status));
-}
 
 /// One thread per query row; the block stages kTile train rows at a time in shared memory. Ties
 /// go to the lower train index, as in the CPU matcher.
@@ -42,14 +37,6 @@ __global__ void twoNearestKernel(const Word* query, int queries, const Word* tra
     __syncthreads();
   }
   if (q < queries) index[q] = nearest, best[q] = b, second[q] = s;
-}
-
-template <typename T>
-void grow(T*& buffer, std::size_t& capacity, std::size_t count) {
-  if (count <= capacity) return;
-  if (buffer) check(cudaFree(buffer), "free");
-  check(cudaMalloc(&buffer, count * sizeof(T)), "malloc");
-  capacity = count;
 }
 
 }  // namespace

@@ -1,8 +1,4 @@
-#include <cuda_runtime.h>
-
-#include <stdexcept>
-#include <string>
-
+#include "device_memory.hpp"
 #include "pcg_device.hpp"
 #include "pcg_loop.hpp"
 
@@ -11,10 +7,6 @@ namespace bundletrack::cuda::detail {
 namespace {
 
 constexpr int kThreads = 256;
-
-void check(cudaError_t status, const char* what) {
-  if (status != cudaSuccess) throw std::runtime_error(std::string("CUDA ") + what + ": " + cudaGetErrorString(status));
-}
 
 /// The threads of one block; sum() leaves the total with every thread.
 struct BlockTeam {

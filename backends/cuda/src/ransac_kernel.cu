@@ -1,8 +1,6 @@
-#include <cuda_runtime.h>
-
 #include <stdexcept>
-#include <string>
 
+#include "device_memory.hpp"
 #include "ransac_body.hpp"
 #include "ransac_device.hpp"
 
@@ -11,10 +9,6 @@ namespace bundletrack::cuda::detail {
 namespace {
 
 constexpr int kThreads = 128;
-
-void check(cudaError_t status, const char* what) {
-  if (status != cudaSuccess) throw std::runtime_error(std::string("CUDA ") + what + ": " + cudaGetErrorString(status));
-}
 
 /// One thread per trial: its sample and fit.
 __global__ void trialKernel(const float* pairs, int n, TrialParameters parameters, int first, int count, double* fits,
@@ -48,14 +42,6 @@ __global__ void countKernel(const float* pairs, int n, const float* hypotheses, 
   if (threadIdx.x == 0) counts[h] = partial[0];
 }
 
-template <typename T>
-void grow(T*& buffer, int& capacity, int count) {
-  if (count <= capacity) return;
-  if (buffer) check(cudaFree(buffer), "free");
-  check(cudaMalloc(&buffer, std::size_t(count) * sizeof(T)), "malloc");
-  capacity = count;
-}
-
 }  // namespace
 
 struct RansacBuffers {
@@ -64,7 +50,8 @@ struct RansacBuffers {
   float* hypotheses = nullptr;
   unsigned char* valid = nullptr;
   int* counts = nullptr;
-  int pair_floats = 0, fit_doubles = 0, hypothesis_floats = 0, valid_bytes = 0, count_ints = 0, n = 0;
+  std::size_t pair_floats = 0, fit_doubles = 0, hypothesis_floats = 0, valid_bytes = 0, count_ints = 0;
+  int n = 0;
 
   ~RansacBuffers() {
     for (void* p : {static_cast<void*>(pairs), static_cast<void*>(fits), static_cast<void*>(hypotheses),
@@ -77,7 +64,7 @@ RansacBuffers* createRansacBuffers() { return new RansacBuffers; }
 void destroyRansacBuffers(RansacBuffers* buffers) { delete buffers; }
 
 void uploadPairs(RansacBuffers& b, const float* pairs, int n) {
-  grow(b.pairs, b.pair_floats, 12 * n);
+  grow(b.pairs, b.pair_floats, std::size_t(12 * n));
   if (n > 0) check(cudaMemcpy(b.pairs, pairs, std::size_t(12 * n) * sizeof(float), cudaMemcpyHostToDevice), "copy pairs");
   b.n = n;
 }
@@ -86,10 +73,10 @@ void scoreTrials(RansacBuffers& b, const TrialParameters& parameters, int first,
                  unsigned char* valid, int* counts) {
   if (count <= 0) return;
   if (b.n < 3) throw std::logic_error("GPU RANSAC: trials need at least 3 uploaded pairs");
-  grow(b.fits, b.fit_doubles, 12 * count);
-  grow(b.hypotheses, b.hypothesis_floats, 12 * count);
-  grow(b.valid, b.valid_bytes, count);
-  grow(b.counts, b.count_ints, count);
+  grow(b.fits, b.fit_doubles, std::size_t(12 * count));
+  grow(b.hypotheses, b.hypothesis_floats, std::size_t(12 * count));
+  grow(b.valid, b.valid_bytes, std::size_t(count));
+  grow(b.counts, b.count_ints, std::size_t(count));
   trialKernel<<<(count + kThreads - 1) / kThreads, kThreads>>>(b.pairs, b.n, parameters, first, count, b.fits,
                                                                b.hypotheses, b.valid);
   check(cudaGetLastError(), "trial kernel launch");
