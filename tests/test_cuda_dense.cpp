@@ -2,6 +2,9 @@
 // without a CUDA device.
 #include <doctest/doctest.h>
 
+#include <algorithm>
+#include <initializer_list>
+
 #include "bundletrack/cuda/dense_point_to_plane.hpp"
 #include "bundletrack/cuda/pcg.hpp"
 #include "bundletrack/residuals/dense_point_to_plane.hpp"
@@ -32,6 +35,30 @@ void compare(const bt::Keyframe& a, const bt::Keyframe& b, const bt::SE3d& T_a, 
   CHECK(on_gpu.cost == doctest::Approx(on_cpu.cost).epsilon(tolerance));
 }
 
+/// Keyframes (dense grid every 4 px) of the given frames of the default synthetic sequence, their
+/// true poses and the grid's camera.
+struct SyntheticKeyframes {
+  std::vector<bt::Keyframe> keyframes;
+  std::vector<bt::SE3d> truth;
+  bt::PinholeCameraf grid;
+};
+
+SyntheticKeyframes syntheticKeyframes(std::initializer_list<int> frames) {
+  synth::SyntheticSequenceSettings settings;
+  settings.frames = std::max(frames) + 1;
+  const synth::SyntheticScene scene(settings);
+  const auto camera = settings.camera.cast<float>();
+  const int step = 4;
+  SyntheticKeyframes out{{}, {}, bt::downsampledCamera(camera, step)};
+  for (const int i : frames) {
+    const synth::SyntheticFrame f = scene.frame(i);
+    const bt::RgbdFrame frame = bt::makeFrame(std::to_string(i), f.color, f.depth, f.mask, camera);
+    out.keyframes.push_back(bt::makeKeyframe(i, frame, frame.mask, {}, f.T_cam_obj, step));
+    out.truth.push_back(f.T_cam_obj);
+  }
+  return out;
+}
+
 }  // namespace
 
 TEST_CASE("GPU dense point-to-plane term equals the CPU term for every loss, with keyframes kept on the device") {
@@ -39,22 +66,9 @@ TEST_CASE("GPU dense point-to-plane term equals the CPU term for every loss, wit
     MESSAGE("SKIPPED: no CUDA device");
     return;
   }
-  synth::SyntheticSequenceSettings settings;
-  settings.frames = 8;
-  const synth::SyntheticScene scene(settings);
-  const auto camera = settings.camera.cast<float>();
-  const int step = 4;
-  std::vector<bt::Keyframe> keyframes;
-  std::vector<bt::SE3d> truth;
-  for (const int i : {0, 7}) {
-    const synth::SyntheticFrame f = scene.frame(i);
-    const bt::RgbdFrame frame = bt::makeFrame(std::to_string(i), f.color, f.depth, f.mask, camera);
-    keyframes.push_back(bt::makeKeyframe(i, frame, frame.mask, {}, f.T_cam_obj, step));
-    truth.push_back(f.T_cam_obj);
-  }
+  const auto [keyframes, truth, grid] = syntheticKeyframes({0, 7});
   // Poses a few millimetres and a degree off the truth, as in a Gauss-Newton iteration.
   const bt::SE3d nudge = bt::SE3d::exp((Eigen::Matrix<double, 6, 1>() << 0.003, -0.002, 0.004, 0.01, -0.015, 0.005).finished());
-  const bt::PinholeCameraf grid = bt::downsampledCamera(camera, step);
   const bt::cuda::DensePointToPlane gpu;
   for (int repeat = 0; repeat < 2; ++repeat) {  // the second round reads the grids kept on the device
     compare(keyframes[0], keyframes[1], truth[0], nudge * truth[1], grid, bt::HuberLoss{}, gpu);
@@ -75,29 +89,20 @@ TEST_CASE("GPU dense term assembles a whole graph in one launch as the CPU term 
     MESSAGE("SKIPPED: no CUDA device");
     return;
   }
-  synth::SyntheticSequenceSettings settings;
-  settings.frames = 10;
-  const synth::SyntheticScene scene(settings);
-  const auto camera = settings.camera.cast<float>();
-  const int step = 4;
-  std::vector<bt::Keyframe> keyframes;
-  std::vector<bt::SE3d> poses;
-  for (const int i : {0, 3, 6, 9}) {
-    const synth::SyntheticFrame f = scene.frame(i);
-    const bt::RgbdFrame frame = bt::makeFrame(std::to_string(i), f.color, f.depth, f.mask, camera);
-    keyframes.push_back(bt::makeKeyframe(i, frame, frame.mask, {}, f.T_cam_obj, step));
-    const double k = double(poses.size());
-    poses.push_back(bt::SE3d::exp((Eigen::Matrix<double, 6, 1>() << 0.002 * k, -0.001 * k, 0.003, 0.005 * k, -0.01, 0.004).finished()) *
-                    f.T_cam_obj);
+  const auto [keyframes, truth, grid] = syntheticKeyframes({0, 3, 6, 9});
+  // Node 0 at its true pose, the others nudged by amounts that grow along the graph.
+  std::vector<bt::SE3d> poses = truth;
+  for (std::size_t k = 1; k < poses.size(); ++k) {
+    const double K = double(k);
+    poses[k] = bt::SE3d::exp((Eigen::Matrix<double, 6, 1>() << 0.002 * K, -0.001 * K, 0.003, 0.005 * K, -0.01, 0.004).finished()) *
+               truth[k];
   }
-  poses[0] = scene.frame(0).T_cam_obj;
   const std::vector<bt::FeatureMatch> none;
   std::vector<const bt::Keyframe*> nodes;
   std::vector<bt::GraphEdge> edges;
   for (const auto& k : keyframes) nodes.push_back(&k);
   for (int a = 0; a < 4; ++a)
     for (int b = a + 1; b < 4; ++b) edges.push_back({a, b, &none});
-  const bt::PinholeCameraf grid = bt::downsampledCamera(camera, step);
   Eigen::MatrixXd H_cpu, H_gpu;
   Eigen::VectorXd b_cpu, b_gpu;
   int residuals_cpu = 0, residuals_gpu = 0;
