@@ -65,6 +65,23 @@ bt::Keyframe surfaceKeyframe(int id, const bt::SE3d& T_cam_obj, const bt::Pinhol
   return k;
 }
 
+/// Four views of the patch, each turned and moved a little from the one before.
+std::vector<bt::SE3d> fourViews() {
+  std::vector<bt::SE3d> views;
+  for (int k = 0; k < 4; ++k)
+    views.emplace_back(bt::SO3d::exp(Eigen::Vector3d(2.8 + 0.05 * k, 0.04 * k, -0.03 * k)),
+                       Eigen::Vector3d(0.01 * k, -0.005 * k, 0.6 + 0.01 * k));
+  return views;
+}
+
+/// Every pair a < b of `nodes` graph nodes as an edge with the given feature correspondences.
+std::vector<bt::GraphEdge> allPairs(int nodes, const std::vector<bt::FeatureMatch>& matches) {
+  std::vector<bt::GraphEdge> edges;
+  for (int a = 0; a < nodes; ++a)
+    for (int b = a + 1; b < nodes; ++b) edges.push_back({a, b, &matches});
+  return edges;
+}
+
 /// The CPU dense term behind the batch interface, recording the size of every batch it is given.
 struct BatchedDense {
   bt::DensePointToPlane dense;
@@ -177,21 +194,15 @@ TEST_CASE("PCG and dense LDLT give the same update on a pose-graph system") {
 TEST_CASE("Gauss-Newton brings perturbed poses back to the truth, node 0 fixed") {
   std::mt19937 rng(5);
   const bt::PinholeCameraf grid{150.0f, 150.0f, 39.5f, 29.5f};
-  std::vector<bt::SE3d> truth;
+  const std::vector<bt::SE3d> truth = fourViews();
   std::vector<bt::Keyframe> frames;
-  for (int k = 0; k < 4; ++k) {
-    truth.emplace_back(bt::SO3d::exp(Eigen::Vector3d(2.8 + 0.05 * k, 0.04 * k, -0.03 * k)),
-                       Eigen::Vector3d(0.01 * k, -0.005 * k, 0.6 + 0.01 * k));
-    frames.push_back(surfaceKeyframe(k, truth.back(), grid));
-  }
+  for (int k = 0; k < 4; ++k) frames.push_back(surfaceKeyframe(k, truth[std::size_t(k)], grid));
   // Features correspond by index (the same grid cells see nearby, not identical, points), so only
   // the dense term is used here; it is exact up to the grid's sampling.
   const std::vector<bt::FeatureMatch> none;
   std::vector<const bt::Keyframe*> nodes;
-  std::vector<bt::GraphEdge> edges;
   for (const auto& f : frames) nodes.push_back(&f);
-  for (int a = 0; a < 4; ++a)
-    for (int b = a + 1; b < 4; ++b) edges.push_back({a, b, &none});
+  const std::vector<bt::GraphEdge> edges = allPairs(4, none);
   std::vector<bt::SE3d> poses = truth;
   for (int k = 1; k < 4; ++k) poses[k] = perturbed(truth[k], rng, 0.004);
   using DenseOnly = bt::Energy<bt::Term<bt::DensePointToPlane, bt::HuberLoss>>;
@@ -213,11 +224,9 @@ TEST_CASE("a batch residual gets every edge of the graph in one call and adds wh
   const bt::PinholeCameraf grid{150.0f, 150.0f, 39.5f, 29.5f};
   std::vector<bt::Keyframe> frames;
   std::vector<bt::SE3d> poses;
-  for (int k = 0; k < 4; ++k) {
-    const bt::SE3d T(bt::SO3d::exp(Eigen::Vector3d(2.8 + 0.05 * k, 0.04 * k, -0.03 * k)),
-                     Eigen::Vector3d(0.01 * k, -0.005 * k, 0.6 + 0.01 * k));
-    frames.push_back(surfaceKeyframe(k, T, grid));
-    poses.push_back(k == 0 ? T : perturbed(T, rng, 0.003));
+  for (const bt::SE3d& T : fourViews()) {
+    frames.push_back(surfaceKeyframe(int(frames.size()), T, grid));
+    poses.push_back(frames.size() == 1 ? T : perturbed(T, rng, 0.003));
   }
   // Features "correspond" by index, as far as every frame has one: the feature term only has to
   // contribute, not to be right.
@@ -226,10 +235,8 @@ TEST_CASE("a batch residual gets every edge of the graph in one call and adds wh
   std::vector<bt::FeatureMatch> matches;
   for (int f = 0; f < int(common); ++f) matches.push_back({f, f});
   std::vector<const bt::Keyframe*> nodes;
-  std::vector<bt::GraphEdge> edges;
   for (const auto& f : frames) nodes.push_back(&f);
-  for (int a = 0; a < 4; ++a)
-    for (int b = a + 1; b < 4; ++b) edges.push_back({a, b, &matches});
+  const std::vector<bt::GraphEdge> edges = allPairs(4, matches);
   using EdgeWise = bt::Energy<bt::Term<bt::FeaturePointToPoint, bt::HuberLoss>, bt::Term<bt::DensePointToPlane, bt::HuberLoss>>;
   using Batched = bt::Energy<bt::Term<bt::FeaturePointToPoint, bt::HuberLoss>, bt::Term<BatchedDense, bt::HuberLoss>>;
   const Batched batched;
