@@ -16,10 +16,7 @@
 #include "bundletrack/synth/synthetic_sequence.hpp"
 #include "bundletrack/tracker.hpp"
 #ifdef BUNDLETRACK_HAS_CUDA
-#include "bundletrack/cuda/dense_point_to_plane.hpp"
-#include "bundletrack/cuda/matching.hpp"
-#include "bundletrack/cuda/pcg.hpp"
-#include "bundletrack/cuda/ransac.hpp"
+#include "bundletrack/cuda/tracker.hpp"
 #endif
 
 namespace bt = bundletrack;
@@ -118,9 +115,7 @@ void run(const std::string& name, const bt::PinholeCameraf& camera, std::size_t 
   report(name + detector, cpu);
   if (!options.gpu) return;
 #ifdef BUNDLETRACK_HAS_CUDA
-  using GpuEnergy = bt::Energy<bt::Term<bt::FeaturePointToPoint, bt::HuberLoss>, bt::Term<bt::cuda::DensePointToPlane, bt::HuberLoss>>;
-  using GpuTracker = bt::Tracker<GpuEnergy, bt::cuda::PCG, bt::cuda::GpuMatched<Detector>, bt::GivenMasks, bt::cuda::Ransac>;
-  const Stages gpu = track(GpuTracker(camera), frames, 0, frame_at);
+  const Stages gpu = track(bt::cuda::Tracker<Detector>(camera), frames, 0, frame_at);
   report(name + detector + " (GPU policies: cuda::PCG, cuda::GpuMatched, cuda::DensePointToPlane, cuda::Ransac)", gpu);
   compare(cpu, gpu);
 #endif

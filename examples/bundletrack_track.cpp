@@ -20,10 +20,7 @@
 #include <opencv2/videoio.hpp>
 #include "bundletrack/tracker.hpp"
 #ifdef BUNDLETRACK_HAS_CUDA
-#include "bundletrack/cuda/dense_point_to_plane.hpp"
-#include "bundletrack/cuda/matching.hpp"
-#include "bundletrack/cuda/pcg.hpp"
-#include "bundletrack/cuda/ransac.hpp"
+#include "bundletrack/cuda/tracker.hpp"
 #endif
 
 namespace bt = bundletrack;
@@ -225,8 +222,7 @@ int runOnGpu(const Options& options, const bt::io::YcbineoatSequence& sequence, 
 #ifdef BUNDLETRACK_HAS_CUDA
   if (!bt::cuda::deviceAvailable())
     throw std::runtime_error("compute.device is gpu, but no CUDA device is available (is the NVIDIA driver loaded?)");
-  using GpuEnergy = bt::Energy<bt::Term<bt::FeaturePointToPoint, bt::HuberLoss>, bt::Term<bt::cuda::DensePointToPlane, bt::HuberLoss>>;
-  using Tracker = bt::Tracker<GpuEnergy, bt::cuda::PCG, bt::cuda::GpuMatched<Source>, Masks, bt::cuda::Ransac>;
+  using Tracker = bt::cuda::Tracker<Source, Masks>;
   return run(Tracker(sequence.camera().cast<float>(), options.config.tracker, {}, {},
                      bt::cuda::GpuMatched<Source>(std::move(source), matching), std::move(masks)),
              sequence, options);

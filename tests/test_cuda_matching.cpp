@@ -3,10 +3,7 @@
 // device.
 #include <doctest/doctest.h>
 
-#include "bundletrack/cuda/dense_point_to_plane.hpp"
-#include "bundletrack/cuda/matching.hpp"
-#include "bundletrack/cuda/pcg.hpp"
-#include "bundletrack/cuda/ransac.hpp"
+#include "bundletrack/cuda/tracker.hpp"
 #include "bundletrack/eval/sequence_score.hpp"
 #include "bundletrack/synth/synthetic_sequence.hpp"
 #include "bundletrack/tracker.hpp"
@@ -86,8 +83,7 @@ TEST_CASE("tracker composed of GPU policies (PCG, matching, dense term, RANSAC) 
   bt::SiftSettings sift;
   sift.matching.guided = false;  // the GPU matcher is exhaustive
   bt::Tracker<bt::DefaultEnergy, bt::PCG, bt::SiftFeatures> cpu(camera, {}, {}, {}, bt::SiftFeatures(sift));
-  using GpuEnergy = bt::Energy<bt::Term<bt::FeaturePointToPoint, bt::HuberLoss>, bt::Term<bt::cuda::DensePointToPlane, bt::HuberLoss>>;
-  bt::Tracker<GpuEnergy, bt::cuda::PCG, bt::cuda::GpuMatched<bt::SiftFeatures>, bt::GivenMasks, bt::cuda::Ransac> gpu(
+  bt::cuda::Tracker<bt::SiftFeatures> gpu(
       camera, {}, {}, {}, bt::cuda::GpuMatched<bt::SiftFeatures>(bt::SiftFeatures(sift), sift.matching));
   std::vector<bt::SE3d> truth, on_cpu, on_gpu;
   for (int i = 0; i < settings.frames; ++i) {

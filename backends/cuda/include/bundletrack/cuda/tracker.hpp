@@ -1,0 +1,20 @@
+#pragma once
+
+#include "bundletrack/cuda/dense_point_to_plane.hpp"
+#include "bundletrack/cuda/matching.hpp"
+#include "bundletrack/cuda/pcg.hpp"
+#include "bundletrack/cuda/ransac.hpp"
+#include "bundletrack/tracker.hpp"
+
+namespace bundletrack::cuda {
+
+/// bundletrack::DefaultEnergy with the dense term on the GPU (the feature term stays on the CPU:
+/// a few hundred residuals per edge).
+using DefaultEnergy = Energy<Term<FeaturePointToPoint, HuberLoss>, Term<DensePointToPlane, HuberLoss>>;
+
+/// The tracker with every GPU policy of this backend: dense term, PCG, descriptor matching and
+/// RANSAC on the device; the Detector finds keypoints on the CPU.
+template <CorrespondenceSource Detector = SiftFeatures, MaskSource Masks = GivenMasks>
+using Tracker = bundletrack::Tracker<DefaultEnergy, PCG, GpuMatched<Detector>, Masks, Ransac>;
+
+}  // namespace bundletrack::cuda
