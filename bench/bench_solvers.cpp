@@ -7,12 +7,12 @@
 #include <benchmark/benchmark.h>
 
 #include <Eigen/IterativeLinearSolvers>
-#include <deque>
 #include <map>
 #include <random>
 
 #include "bundletrack/synth/synthetic_sequence.hpp"
-#include "bundletrack/tracker.hpp"
+#include "bundletrack/default_tracker.hpp"
+#include "bundletrack/solvers/dense_ldlt.hpp"
 
 namespace bt = bundletrack;
 
@@ -54,18 +54,11 @@ const TrackedKeyframes& trackedKeyframes() {
 
 /// The pose graph over the first `nodes` keyframes: all pairs, features matched with the pose gate
 /// and pruned by RANSAC, as the tracker builds it.
-struct Graph {
-  std::vector<const bt::Keyframe*> nodes;
-  std::vector<bt::SE3d> poses;
-  std::deque<std::vector<bt::FeatureMatch>> matches;
-  std::vector<bt::GraphEdge> edges;
-};
-
-const Graph& graphOfSize(int size) {
-  static std::map<int, Graph> graphs;
+const bt::PoseGraph& graphOfSize(int size) {
+  static std::map<int, bt::PoseGraph> graphs;
   if (auto found = graphs.find(size); found != graphs.end()) return found->second;
   const TrackedKeyframes& run = trackedKeyframes();
-  Graph& graph = graphs[size];
+  bt::PoseGraph& graph = graphs[size];
   const int count = std::min<int>(size, int(run.keyframes.size()));
   for (int k = 0; k < count; ++k)
     graph.nodes.push_back(&run.keyframes[std::size_t(k)]), graph.poses.push_back(run.keyframes[std::size_t(k)].T_cam_obj);
@@ -73,12 +66,13 @@ const Graph& graphOfSize(int size) {
   const bt::Ransac ransac;
   for (int a = 0; a < count; ++a) {
     for (int b = a + 1; b < count; ++b) {
-      const bt::MatchGate gate{(graph.poses[b] * graph.poses[a].inverse()).cast<float>()};
+      const bt::MatchGate gate{(graph.poses[b] * graph.poses[a].inverse()).cast<float>(), {}};
       const auto m = sift.match(graph.nodes[a]->features, graph.nodes[b]->features, gate);
       const auto pruned = ransac.estimate(graph.nodes[a]->features, graph.nodes[b]->features, m);
-      graph.matches.emplace_back();
-      for (const int k : pruned.inliers) graph.matches.back().push_back(m[std::size_t(k)]);
-      graph.edges.push_back({a, b, &graph.matches.back()});
+      std::vector<bt::FeatureMatch>& inliers = graph.current_matches.emplace_back();
+      for (const int k : pruned.inliers) inliers.push_back(m[std::size_t(k)]);
+      graph.edges.push_back({a, b});
+      graph.matches.push_back(&inliers);
     }
   }
   return graph;
@@ -88,13 +82,11 @@ const Graph& graphOfSize(int size) {
 const System& systemOfSize(int nodes) {
   static std::map<int, System> systems;
   if (auto found = systems.find(nodes); found != systems.end()) return found->second;
-  const Graph& graph = graphOfSize(nodes);
-  System system;
-  Eigen::VectorXd b;
-  int residuals = 0;
-  bt::assembleNormalEquations(bt::DefaultEnergy{}, graph.nodes, graph.edges,
-                              bt::downsampledCamera(trackedKeyframes().camera, 4), graph.poses, system.H, b, residuals);
-  system.rhs = -b;
+  const bt::PoseGraph& graph = graphOfSize(nodes);
+  const bt::DefaultEnergy energy;
+  bt::Linearisation at;
+  bt::assembleNormalEquations(energy.over(graph), graph.poses, at);
+  System system{at.H, -at.b};
   if (system.rhs.norm() == 0.0) system.rhs.setOnes();  // at the optimum b = 0: solve for a unit load instead
   return systems.emplace(nodes, std::move(system)).first->second;
 }
@@ -102,17 +94,16 @@ const System& systemOfSize(int nodes) {
 /// Residual evaluation and normal-equation assembly of one energy term over a whole graph.
 template <typename EnergyT>
 void assemble(benchmark::State& state) {
-  const Graph& graph = graphOfSize(int(state.range(0)));
-  const bt::PinholeCameraf grid = bt::downsampledCamera(trackedKeyframes().camera, 4);
-  Eigen::MatrixXd H;
-  Eigen::VectorXd b;
-  int residuals = 0;
+  const bt::PoseGraph& graph = graphOfSize(int(state.range(0)));
+  const EnergyT energy;
+  const auto problem = energy.over(graph);
+  bt::Linearisation at;
   for (auto _ : state) {
-    bt::assembleNormalEquations(EnergyT{}, graph.nodes, graph.edges, grid, graph.poses, H, b, residuals);
-    benchmark::DoNotOptimize(H.data());
+    bt::assembleNormalEquations(problem, graph.poses, at);
+    benchmark::DoNotOptimize(at.H.data());
   }
-  state.counters["residuals"] = residuals;
-  state.counters["residuals_per_second"] = benchmark::Counter(double(residuals), benchmark::Counter::kIsIterationInvariantRate);
+  state.counters["residuals"] = at.residuals;
+  state.counters["residuals_per_second"] = benchmark::Counter(double(at.residuals), benchmark::Counter::kIsIterationInvariantRate);
 }
 
 void BM_AssembleFeatureTerm(benchmark::State& state) {

@@ -1,5 +1,6 @@
 // bench_tracker [--sequence DIR ...] [--frames N] [--memory-every N] [--features F] [--gpu]
-// Runs the default tracker (with --features orb|akaze: that detector instead of SIFT) on each sequence (or on a synthetic one rendered in memory) and prints,
+// Runs the default tracker (with --features orb|akaze: that detector instead of SIFT; built by
+// makeTracker) on each sequence (or on a synthetic one rendered in memory) and prints,
 // per stage, the median and 90th percentile of the milliseconds per frame, the share of the
 // median frame, and frames per second (tracking only, and with reading + preprocessing).
 // --memory-every N also prints, every N frames, the keyframes in the pool and the process's
@@ -9,15 +10,14 @@
 #include <algorithm>
 #include <cstdio>
 #include <fstream>
+#include <memory>
 #include <string>
 #include <vector>
 
 #include "bundletrack/io/ycbineoat_sequence.hpp"
+#include "bundletrack/runtime/make_tracker.hpp"
 #include "bundletrack/synth/synthetic_sequence.hpp"
-#include "bundletrack/tracker.hpp"
-#ifdef BUNDLETRACK_HAS_CUDA
-#include "bundletrack/cuda/tracker.hpp"
-#endif
+#include "bundletrack/tracking/stopwatch.hpp"
 
 namespace bt = bundletrack;
 
@@ -64,8 +64,8 @@ std::pair<double, double> residentMemoryMiB() {
   return {rss, peak};
 }
 
-template <typename Tracker, typename FrameAt>
-Stages track(Tracker tracker, std::size_t frames, int memory_every, FrameAt&& frame_at) {
+template <typename FrameAt>
+Stages track(bt::AnyTracker& tracker, std::size_t frames, int memory_every, FrameAt&& frame_at) {
   Stages stages;
   if (memory_every > 0) std::printf("%8s %10s %12s %13s %6s\n", "frame", "keyframes", "resident MiB", "peak MiB", "lost");
   int lost = 0;
@@ -78,7 +78,7 @@ Stages track(Tracker tracker, std::size_t frames, int memory_every, FrameAt&& fr
     if (i > 0) stages.add(read_ms, result.timings);
     if (memory_every > 0 && ((i + 1) % std::size_t(memory_every) == 0 || i + 1 == frames)) {
       const auto [rss, peak] = residentMemoryMiB();
-      std::printf("%8zu %10zu %12.1f %13.1f %6d\n", i + 1, tracker.keyframes().size(), rss, peak, lost);
+      std::printf("%8zu %10zu %12.1f %13.1f %6d\n", i + 1, tracker.keyframeCount(), rss, peak, lost);
       std::fflush(stdout);
     }
   }
@@ -106,28 +106,23 @@ struct Options {
   bool gpu = false;
 };
 
-/// The default tracker with `Detector` on the frames, and with --gpu the GPU-composed one as well.
-template <typename Detector, typename FrameAt>
+/// The default tracker with the --features detector on the frames, and with --gpu the
+/// GPU-composed one as well.
+template <typename FrameAt>
 void run(const std::string& name, const bt::PinholeCameraf& camera, std::size_t frames, const Options& options,
          FrameAt&& frame_at) {
-  const std::string detector = " [" + options.features + "]";
-  const Stages cpu = track(bt::Tracker<bt::DefaultEnergy, bt::PCG, Detector>(camera), frames, options.memory_every, frame_at);
-  report(name + detector, cpu);
-  if (!options.gpu) return;
-#ifdef BUNDLETRACK_HAS_CUDA
-  const Stages gpu = track(bt::cuda::Tracker<Detector>(camera), frames, 0, frame_at);
-  report(name + detector + " (GPU policies: cuda::PCG, cuda::GpuMatched, cuda::DensePointToPlane, cuda::Ransac)", gpu);
+  bt::Config config;
+  config.features = options.features;
+  const std::unique_ptr<bt::AnyTracker> cpu_tracker = bt::makeTracker(config, camera);
+  config.device = "gpu";
+  const std::unique_ptr<bt::AnyTracker> gpu_tracker = options.gpu ? bt::makeTracker(config, camera) : nullptr;
+  const std::string label = name + " [" + options.features + "]";
+  const Stages cpu = track(*cpu_tracker, frames, options.memory_every, frame_at);
+  report(label, cpu);
+  if (!gpu_tracker) return;
+  const Stages gpu = track(*gpu_tracker, frames, 0, frame_at);
+  report(label + " (GPU policies: cuda::PCG, cuda::GpuMatched, cuda::DensePointToPlane, cuda::Ransac)", gpu);
   compare(cpu, gpu);
-#endif
-}
-
-/// run() with the detector --features names.
-template <typename FrameAt>
-void runWithDetector(const std::string& name, const bt::PinholeCameraf& camera, std::size_t frames,
-                     const Options& options, FrameAt&& frame_at) {
-  if (options.features == "orb") run<bt::OrbFeatures>(name, camera, frames, options, frame_at);
-  else if (options.features == "akaze") run<bt::AkazeFeatures>(name, camera, frames, options, frame_at);
-  else run<bt::SiftFeatures>(name, camera, frames, options, frame_at);
 }
 
 }  // namespace
@@ -159,17 +154,6 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "error: --features: '%s' is not sift, orb or akaze\n%s", options.features.c_str(), usage);
     return 2;
   }
-#ifdef BUNDLETRACK_HAS_CUDA
-  if (options.gpu && !bt::cuda::deviceAvailable()) {
-    std::fprintf(stderr, "error: --gpu: no CUDA device available\n");
-    return 1;
-  }
-#else
-  if (options.gpu) {
-    std::fprintf(stderr, "error: --gpu: this build has no CUDA backend (configure with BUNDLETRACK_CUDA=ON)\n");
-    return 1;
-  }
-#endif
   const int frames = options.frames;
   try {
     if (options.sequences.empty()) {
@@ -177,7 +161,7 @@ int main(int argc, char** argv) {
       settings.frames = frames;
       const bt::synth::SyntheticScene scene(settings);
       const auto camera = settings.camera.cast<float>();
-      runWithDetector("synthetic hand-held box (rendering counted as reading)", camera, std::size_t(frames), options,
+      run("synthetic hand-held box (rendering counted as reading)", camera, std::size_t(frames), options,
           [&](std::size_t i) {
             const auto f = scene.frame(int(i));
             return std::pair(bt::makeFrame(std::to_string(i), f.color, f.depth, f.mask, camera), f.T_cam_obj);
@@ -185,7 +169,7 @@ int main(int argc, char** argv) {
     }
     for (const auto& dir : options.sequences) {
       const bt::io::YcbineoatSequence sequence(dir);
-      runWithDetector(dir, sequence.camera().cast<float>(), sequence.size(), options, [&](std::size_t i) {
+      run(dir, sequence.camera().cast<float>(), sequence.size(), options, [&](std::size_t i) {
         return std::pair(sequence.frame(i), sequence.hasGroundTruth() ? sequence.groundTruthPose(i) : bt::SE3d());
       });
     }

@@ -12,16 +12,16 @@
 
 #include <unistd.h>
 
-#include "bundletrack/eval/mask_iou.hpp"
-#include "bundletrack/eval/score_table.hpp"
-#include "bundletrack/io/config.hpp"
-#include "bundletrack/viz/overlay.hpp"
-
 #include <opencv2/videoio.hpp>
-#include "bundletrack/tracker.hpp"
-#ifdef BUNDLETRACK_HAS_CUDA
-#include "bundletrack/cuda/tracker.hpp"
-#endif
+
+#include "bundletrack/config/config_file.hpp"
+#include "bundletrack/eval/mask_iou.hpp"
+#include "bundletrack/eval/pose_metrics.hpp"
+#include "bundletrack/eval/score_table.hpp"
+#include "bundletrack/eval/sequence_score.hpp"
+#include "bundletrack/runtime/make_tracker.hpp"
+#include "bundletrack/tracking/stopwatch.hpp"
+#include "bundletrack/viz/overlay.hpp"
 
 namespace bt = bundletrack;
 namespace fs = std::filesystem;
@@ -31,6 +31,7 @@ namespace {
 const char* const kUsage = R"(usage: bundletrack_track --sequence DIR --out DIR [options]
   --config FILE      YAML settings over the defaults (see --print-config); options below override it
   --print-config     print the effective configuration as YAML and exit
+  --print-config-table  print every setting with its default as a Markdown table and exit
   --features F       sift | orb | akaze (sift)
   --tracker T        full: pose graph over keyframes (paper IV) | coarse: frame-to-frame RANSAC only (full)
   --depth-scale S    metres per unit of the depth images (0.001)
@@ -65,8 +66,7 @@ double number(const std::string& option, const std::string& text) {
 
 struct Options {
   fs::path sequence, out, config_file;
-  std::string tracker = "full";
-  bt::io::Config config;
+  bt::Config config;
   bool quiet = false;
   bool viz = false;
 };
@@ -124,8 +124,7 @@ double median(std::vector<double> values) {
   return values[values.size() / 2];
 }
 
-template <typename Tracker>
-int run(Tracker tracker, const bt::io::YcbineoatSequence& sequence, const Options& options) {
+int run(bt::AnyTracker& tracker, const bt::io::YcbineoatSequence& sequence, const Options& options) {
   fs::create_directories(options.out / "poses");
   if (options.config.masks == "propagated") fs::create_directories(options.out / "masks");
   std::ofstream csv(options.out / "track.csv");
@@ -215,42 +214,6 @@ int run(Tracker tracker, const bt::io::YcbineoatSequence& sequence, const Option
   return 0;
 }
 
-/// The full tracker with the GPU policies of bundletrack::cuda (compute.device: gpu).
-template <typename Source, typename Masks>
-int runOnGpu(const Options& options, const bt::io::YcbineoatSequence& sequence, Source source,
-             const bt::MatchSettings& matching, Masks masks) {
-#ifdef BUNDLETRACK_HAS_CUDA
-  if (!bt::cuda::deviceAvailable())
-    throw std::runtime_error("compute.device is gpu, but no CUDA device is available (is the NVIDIA driver loaded?)");
-  using Tracker = bt::cuda::Tracker<Source, Masks>;
-  return run(Tracker(sequence.camera().cast<float>(), options.config.tracker, {}, {},
-                     bt::cuda::GpuMatched<Source>(std::move(source), matching), std::move(masks)),
-             sequence, options);
-#else
-  (void)options, (void)sequence, (void)source, (void)matching, (void)masks;
-  throw std::runtime_error("compute.device is gpu, but this build has no CUDA backend (configure with "
-                           "-DBUNDLETRACK_CUDA=ON on a machine with nvcc)");
-#endif
-}
-
-template <typename Source>
-int runWith(const Options& options, const typename Source::Settings& source_settings) {
-  const bt::io::YcbineoatSequence sequence(options.sequence, options.config.sequence);
-  const bt::TrackerSettings& settings = options.config.tracker;
-  if (options.tracker == "coarse") return run(bt::CoarseTracker<Source>(Source(source_settings), settings.coarse), sequence, options);
-  const bt::PinholeCameraf camera = sequence.camera().cast<float>();
-  const bool gpu = options.config.device == "gpu";
-  if (options.config.masks == "propagated") {
-    bt::PropagatedMasks masks(options.config.propagated_masks);
-    if (gpu) return runOnGpu(options, sequence, Source(source_settings), source_settings.matching, std::move(masks));
-    using Tracker = bt::Tracker<bt::DefaultEnergy, bt::PCG, Source, bt::PropagatedMasks>;
-    return run(Tracker(camera, settings, {}, {}, Source(source_settings), std::move(masks)), sequence, options);
-  }
-  if (gpu) return runOnGpu(options, sequence, Source(source_settings), source_settings.matching, bt::GivenMasks());
-  using Tracker = bt::Tracker<bt::DefaultEnergy, bt::PCG, Source>;
-  return run(Tracker(camera, settings, {}, {}, Source(source_settings)), sequence, options);
-}
-
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -265,9 +228,13 @@ int main(int argc, char** argv) {
     };
     if (arg == "--sequence") options.sequence = value();
     else if (arg == "--out") options.out = value();
-    else if (arg == "--tracker") options.tracker = value();
+    else if (arg == "--tracker") overrides.emplace_back(arg, value());
     else if (arg == "--config") options.config_file = value();
     else if (arg == "--print-config") print_config = true;
+    else if (arg == "--print-config-table") {
+      std::cout << bt::settingsTable();
+      return 0;
+    }
     else if (arg == "--features" || arg == "--depth-scale" || arg == "--min-inliers" || arg == "--inlier-mm")
       overrides.emplace_back(arg, value());
     else if (arg == "--propagate-masks" || arg == "--gpu") overrides.emplace_back(arg, "");
@@ -279,30 +246,30 @@ int main(int argc, char** argv) {
     } else fail("unknown option '" + arg + "'");
   }
   try {
-    if (!options.config_file.empty()) options.config = bt::io::loadConfig(options.config_file);
+    if (!options.config_file.empty()) options.config = bt::loadConfig(options.config_file);
     auto& config = options.config;
     for (const auto& [option, text] : overrides) {
-      if (option == "--features") config.features = text;
+      if (option == "--tracker") config.tracker = text;
+      else if (option == "--features") config.features = text;
       else if (option == "--depth-scale") config.sequence.depth_scale = number(option, text);
-      else if (option == "--min-inliers") config.tracker.coarse.min_inliers = int(number(option, text));
-      else if (option == "--inlier-mm") config.tracker.coarse.ransac.inlier_distance = float(number(option, text) * 1e-3);
+      else if (option == "--min-inliers") config.tracking.min_inliers = int(number(option, text));
+      else if (option == "--inlier-mm") config.ransac.inlier_distance = float(number(option, text) * 1e-3);
       else if (option == "--propagate-masks") config.masks = "propagated";
       else if (option == "--gpu") config.device = "gpu";
     }
     if (print_config) {
-      std::cout << bt::io::printConfig(config);
+      std::cout << bt::printConfig(config);
       return 0;
     }
     if (options.sequence.empty() || options.out.empty()) fail("--sequence and --out are required");
-    if (options.tracker != "coarse" && options.tracker != "full") fail("unknown tracker '" + options.tracker + "'");
-    if (options.tracker == "coarse" && config.masks == "propagated")
-      fail("propagated masks need the full tracker (they render its keyframes)");
-    if (options.tracker == "coarse" && config.device == "gpu")
-      fail("the GPU policies serve the full tracker; the coarse tracker runs on the CPU");
-    if (config.features == "sift") return runWith<bt::SiftFeatures>(options, config.sift);
-    if (config.features == "orb") return runWith<bt::OrbFeatures>(options, config.orb);
-    if (config.features == "akaze") return runWith<bt::AkazeFeatures>(options, config.akaze);
-    fail("unknown features '" + config.features + "'");
+    if (config.tracker != "coarse" && config.tracker != "full") fail("unknown tracker '" + config.tracker + "'");
+    if (config.features != "sift" && config.features != "orb" && config.features != "akaze")
+      fail("unknown features '" + config.features + "'");
+    const bt::io::YcbineoatSequence sequence(options.sequence, config.sequence);
+    const std::unique_ptr<bt::AnyTracker> tracker = bt::makeTracker(config, sequence.camera().cast<float>());
+    return run(*tracker, sequence, options);
+  } catch (const std::invalid_argument& error) {
+    fail(error.what());
   } catch (const std::exception& error) {
     std::cerr << "\nerror: " << error.what() << '\n';
     return 1;

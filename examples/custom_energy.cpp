@@ -8,17 +8,20 @@
 
 #include "bundletrack/eval/sequence_score.hpp"
 #include "bundletrack/synth/synthetic_sequence.hpp"
-#include "bundletrack/tracker.hpp"
+#include "bundletrack/default_tracker.hpp"
+#include "bundletrack/solvers/dense_ldlt.hpp"
 
 namespace bt = bundletrack;
 
 // The energy is a type: swap a term, a loss or a weight and the compiler builds a new tracker.
 using FeatureOnlyEnergy = bt::Energy<bt::Term<bt::FeaturePointToPoint, bt::CauchyLoss>>;
-using FeatureOnlyTracker = bt::Tracker<FeatureOnlyEnergy, bt::DenseLDLT, bt::SiftFeatures>;
+using FeatureOnlyTracker =
+    bt::Tracker<FeatureOnlyEnergy, bt::DenseLDLT, bt::SiftFeatures, bt::GivenMasks, bt::Ransac, bt::SurfaceAgreement>;
 
 using FeatureAndDenseEnergy =
     bt::Energy<bt::Term<bt::FeaturePointToPoint, bt::HuberLoss>, bt::Term<bt::DensePointToPlane, bt::HuberLoss>>;
-using FeatureAndDenseTracker = bt::Tracker<FeatureAndDenseEnergy, bt::PCG, bt::SiftFeatures>;
+using FeatureAndDenseTracker =
+    bt::Tracker<FeatureAndDenseEnergy, bt::PCG, bt::SiftFeatures, bt::GivenMasks, bt::Ransac, bt::SurfaceAgreement>;
 
 template <typename Tracker>
 void run(const char* label, Tracker tracker, const bt::synth::SyntheticScene& scene) {

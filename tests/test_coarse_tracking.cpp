@@ -3,9 +3,9 @@
 
 #include <algorithm>
 
+#include "bundletrack/default_tracker.hpp"
 #include "bundletrack/eval/pose_metrics.hpp"
 #include "bundletrack/synth/synthetic_sequence.hpp"
-#include "bundletrack/tracking/coarse_tracker.hpp"
 
 namespace bt = bundletrack;
 namespace synth = bundletrack::synth;
@@ -69,7 +69,7 @@ TEST_CASE_TEMPLATE("coarse tracker: per-frame relative pose errors on a syntheti
   settings.frames = 30;
   settings.speed = 2.0;  // ~2 deg and ~5 mm per frame: a tracker that misses the motion fails the bounds
   const synth::SyntheticScene scene(settings);
-  bt::CoarseTracker<Source> tracker;
+  bt::CoarseTracker<Source, bt::Ransac> tracker;
   tracker.initialize(syntheticFrame(scene, 0), scene.T_cam_obj(0));
   bt::SE3d previous_estimate = scene.T_cam_obj(0);
   std::vector<double> rotation, translation, step;
@@ -103,7 +103,7 @@ TEST_CASE("coarse tracker reports lost frames instead of repeating the pose sile
   synth::SyntheticSequenceSettings settings;
   settings.frames = 10;
   const synth::SyntheticScene scene(settings);
-  bt::CoarseTracker<> tracker;
+  bt::DefaultCoarseTracker tracker;
   tracker.initialize(syntheticFrame(scene, 0), scene.T_cam_obj(0));
   bt::RgbdFrame hidden = syntheticFrame(scene, 1);
   hidden.mask.setTo(0);  // the object is gone from view

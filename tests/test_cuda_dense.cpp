@@ -7,9 +7,11 @@
 
 #include "bundletrack/cuda/dense_point_to_plane.hpp"
 #include "bundletrack/cuda/pcg.hpp"
+#include "bundletrack/energy.hpp"
 #include "bundletrack/residuals/dense_point_to_plane.hpp"
 #include "bundletrack/solvers/gauss_newton.hpp"
 #include "bundletrack/synth/synthetic_sequence.hpp"
+#include "pose_graph_fixture.hpp"
 
 namespace bt = bundletrack;
 namespace synth = bundletrack::synth;
@@ -19,13 +21,12 @@ static_assert(bt::BatchResidual<bt::cuda::DensePointToPlane>, "the GPU dense ter
 namespace {
 
 template <typename Loss>
-void compare(const bt::Keyframe& a, const bt::Keyframe& b, const bt::SE3d& T_a, const bt::SE3d& T_b,
-             const bt::PinholeCameraf& grid, const Loss& loss, const bt::cuda::DensePointToPlane& gpu) {
-  const std::vector<bt::FeatureMatch> none;
-  const bt::PairInput input{a, b, T_a, T_b, none, grid};
+void compare(const bt::Keyframe& a, const bt::Keyframe& b, const bt::SE3d& T_a, const bt::SE3d& T_b, const Loss& loss,
+             const bt::cuda::DensePointToPlane& gpu) {
+  const bt::DensePointToPlane::Input input{a.surface, b.surface};
   bt::PairSystem on_cpu, on_gpu;
-  bt::DensePointToPlane{}.linearise(input, loss, 0.7, on_cpu);
-  gpu.linearise(input, loss, 0.7, on_gpu);
+  bt::DensePointToPlane{}.linearise(input, T_a, T_b, loss, 0.7, on_cpu);
+  gpu.linearise(input, T_a, T_b, loss, 0.7, on_gpu);
   REQUIRE(on_cpu.residuals > 500);
   // The same residuals up to projections that round the other way at a pixel or gate boundary.
   CHECK(std::abs(on_gpu.residuals - on_cpu.residuals) <= on_cpu.residuals / 1000 + 1);
@@ -35,12 +36,11 @@ void compare(const bt::Keyframe& a, const bt::Keyframe& b, const bt::SE3d& T_a, 
   CHECK(on_gpu.cost == doctest::Approx(on_cpu.cost).epsilon(tolerance));
 }
 
-/// Keyframes (dense grid every 4 px) of the given frames of the default synthetic sequence, their
-/// true poses and the grid's camera.
+/// Keyframes (dense grid every 4 px) of the given frames of the default synthetic sequence and
+/// their true poses.
 struct SyntheticKeyframes {
   std::vector<bt::Keyframe> keyframes;
   std::vector<bt::SE3d> truth;
-  bt::PinholeCameraf grid;
 };
 
 SyntheticKeyframes syntheticKeyframes(std::initializer_list<int> frames) {
@@ -49,11 +49,11 @@ SyntheticKeyframes syntheticKeyframes(std::initializer_list<int> frames) {
   const synth::SyntheticScene scene(settings);
   const auto camera = settings.camera.cast<float>();
   const int step = 4;
-  SyntheticKeyframes out{{}, {}, bt::downsampledCamera(camera, step)};
+  SyntheticKeyframes out;
   for (const int i : frames) {
     const synth::SyntheticFrame f = scene.frame(i);
     const bt::RgbdFrame frame = bt::makeFrame(std::to_string(i), f.color, f.depth, f.mask, camera);
-    out.keyframes.push_back(bt::makeKeyframe(i, frame, frame.mask, {}, f.T_cam_obj, step));
+    out.keyframes.push_back(bt::makeKeyframe(i, frame, frame.mask, {}, f.T_cam_obj, camera, step));
     out.truth.push_back(f.T_cam_obj);
   }
   return out;
@@ -66,22 +66,21 @@ TEST_CASE("GPU dense point-to-plane term equals the CPU term for every loss, wit
     MESSAGE("SKIPPED: no CUDA device");
     return;
   }
-  const auto [keyframes, truth, grid] = syntheticKeyframes({0, 7});
+  const auto [keyframes, truth] = syntheticKeyframes({0, 7});
   // Poses a few millimetres and a degree off the truth, as in a Gauss-Newton iteration.
   const bt::SE3d nudge = bt::SE3d::exp((Eigen::Matrix<double, 6, 1>() << 0.003, -0.002, 0.004, 0.01, -0.015, 0.005).finished());
   const bt::cuda::DensePointToPlane gpu;
   for (int repeat = 0; repeat < 2; ++repeat) {  // the second round reads the grids kept on the device
-    compare(keyframes[0], keyframes[1], truth[0], nudge * truth[1], grid, bt::HuberLoss{}, gpu);
-    compare(keyframes[0], keyframes[1], truth[0], nudge * truth[1], grid, bt::TrivialLoss{}, gpu);
-    compare(keyframes[0], keyframes[1], truth[0], nudge * truth[1], grid, bt::CauchyLoss{}, gpu);
-    compare(keyframes[0], keyframes[1], truth[0], nudge * truth[1], grid, bt::TukeyLoss{}, gpu);
+    compare(keyframes[0], keyframes[1], truth[0], nudge * truth[1], bt::HuberLoss{}, gpu);
+    compare(keyframes[0], keyframes[1], truth[0], nudge * truth[1], bt::TrivialLoss{}, gpu);
+    compare(keyframes[0], keyframes[1], truth[0], nudge * truth[1], bt::CauchyLoss{}, gpu);
+    compare(keyframes[0], keyframes[1], truth[0], nudge * truth[1], bt::TukeyLoss{}, gpu);
   }
-  // A keyframe whose grid changed under the same id is uploaded again, not read stale.
+  // A keyframe whose grid changed is uploaded again, not read stale.
   bt::Keyframe moved = keyframes[1];
-  moved.points = keyframes[1].points.clone();
-  moved.points += cv::Scalar(0.001, 0.0, 0.0);
-  bt::indexSurface(moved);
-  compare(keyframes[0], moved, truth[0], nudge * truth[1], grid, bt::HuberLoss{}, gpu);
+  moved.surface.points = keyframes[1].surface.points.clone();
+  moved.surface.points += cv::Scalar(0.001, 0.0, 0.0);
+  compare(keyframes[0], moved, truth[0], nudge * truth[1], bt::HuberLoss{}, gpu);
 }
 
 TEST_CASE("GPU dense term assembles a whole graph in one launch as the CPU term does edge by edge") {
@@ -89,7 +88,7 @@ TEST_CASE("GPU dense term assembles a whole graph in one launch as the CPU term 
     MESSAGE("SKIPPED: no CUDA device");
     return;
   }
-  const auto [keyframes, truth, grid] = syntheticKeyframes({0, 3, 6, 9});
+  const auto [keyframes, truth] = syntheticKeyframes({0, 3, 6, 9});
   // Node 0 at its true pose, the others nudged by amounts that grow along the graph.
   std::vector<bt::SE3d> poses = truth;
   for (std::size_t k = 1; k < poses.size(); ++k) {
@@ -98,24 +97,18 @@ TEST_CASE("GPU dense term assembles a whole graph in one launch as the CPU term 
                truth[k];
   }
   const std::vector<bt::FeatureMatch> none;
-  std::vector<const bt::Keyframe*> nodes;
-  std::vector<bt::GraphEdge> edges;
-  for (const auto& k : keyframes) nodes.push_back(&k);
-  for (int a = 0; a < 4; ++a)
-    for (int b = a + 1; b < 4; ++b) edges.push_back({a, b, &none});
-  Eigen::MatrixXd H_cpu, H_gpu;
-  Eigen::VectorXd b_cpu, b_gpu;
-  int residuals_cpu = 0, residuals_gpu = 0;
-  const double cost_cpu = bt::assembleNormalEquations(bt::Energy<bt::Term<bt::DensePointToPlane, bt::HuberLoss>>{}, nodes,
-                                                      edges, grid, poses, H_cpu, b_cpu, residuals_cpu);
+  const bt::PoseGraph graph = allPairsGraph(keyframes, poses, none);
+  bt::Linearisation cpu, on_gpu;
+  const bt::Energy<bt::Term<bt::DensePointToPlane, bt::HuberLoss>> cpu_energy;
+  bt::assembleNormalEquations(cpu_energy.over(graph), graph.poses, cpu);
   const bt::Energy<bt::Term<bt::cuda::DensePointToPlane, bt::HuberLoss>> gpu;
   for (int repeat = 0; repeat < 2; ++repeat) {  // the second time with the grids already on the device
-    const double cost_gpu = bt::assembleNormalEquations(gpu, nodes, edges, grid, poses, H_gpu, b_gpu, residuals_gpu);
-    REQUIRE(residuals_cpu > 3000);
-    CHECK(std::abs(residuals_gpu - residuals_cpu) <= residuals_cpu / 1000 + 1);
-    const double tolerance = residuals_gpu == residuals_cpu ? 1e-4 : 1e-2;
-    CHECK((H_gpu - H_cpu).norm() <= tolerance * H_cpu.norm());
-    CHECK((b_gpu - b_cpu).norm() <= tolerance * b_cpu.norm());
-    CHECK(cost_gpu == doctest::Approx(cost_cpu).epsilon(tolerance));
+    bt::assembleNormalEquations(gpu.over(graph), graph.poses, on_gpu);
+    REQUIRE(cpu.residuals > 3000);
+    CHECK(std::abs(on_gpu.residuals - cpu.residuals) <= cpu.residuals / 1000 + 1);
+    const double tolerance = on_gpu.residuals == cpu.residuals ? 1e-4 : 1e-2;
+    CHECK((on_gpu.H - cpu.H).norm() <= tolerance * cpu.H.norm());
+    CHECK((on_gpu.b - cpu.b).norm() <= tolerance * cpu.b.norm());
+    CHECK(on_gpu.cost == doctest::Approx(cpu.cost).epsilon(tolerance));
   }
 }

@@ -55,30 +55,31 @@ FramePair syntheticFrames(int later) {
 
 /// The GPU dense term's edge system, with every cell run through the kernel body on the host.
 template <typename Loss>
-bt::PairSystem denseOnHost(const bt::PairInput& in, const Loss& loss, double weight) {
-  const bt::cuda::LossParameters parameters = bt::cuda::lossParameters(loss);
+bt::PairSystem denseOnHost(const bt::DensePointToPlane::Input& in, const bt::SE3d& T_i, const bt::SE3d& T_j,
+                           const Loss& loss, double weight) {
+  const bt::LossParameters parameters = bt::lossParameters(loss);
   const bt::DensePointToPlane gates;  // the CPU term's defaults, which the GPU term shares
   bt::PairSystem system;
-  const auto pass = [&](const bt::Keyframe& s, const bt::Keyframe& t, const bt::SE3d& T_s, const bt::SE3d& T_t,
+  const auto pass = [&](const bt::SurfaceGrid& s, const bt::SurfaceGrid& t, const bt::SE3d& T_s, const bt::SE3d& T_t,
                         bool swapped) {
-    const detail::DirectedPass p = detail::directedPass(T_s, T_t, in.grid_camera, gates.max_distance,
-                                                        gates.max_normal_angle_deg, parameters, weight);
+    const detail::DirectedPass p = detail::directedPass(T_s, T_t, t.camera, gates.gate, parameters, weight);
     double sums[detail::kDenseSums] = {};
     for (const int cell : detail::surfaceCells(s))
       detail::addDenseCell(s.points.ptr<float>(), s.normals.ptr<float>(), cell, t.points.ptr<float>(),
                            t.normals.ptr<float>(), t.points.cols, t.points.rows, p, sums);
     detail::addPassSums(sums, swapped, system);
   };
-  pass(in.i, in.j, in.T_i, in.T_j, false);
-  pass(in.j, in.i, in.T_j, in.T_i, true);
+  pass(in.i, in.j, T_i, T_j, false);
+  pass(in.j, in.i, T_j, T_i, true);
   system.finish();
   return system;
 }
 
 template <typename Loss>
-bt::PairSystem denseOnCpu(const bt::PairInput& in, const Loss& loss, double weight) {
+bt::PairSystem denseOnCpu(const bt::DensePointToPlane::Input& in, const bt::SE3d& T_i, const bt::SE3d& T_j,
+                          const Loss& loss, double weight) {
   bt::PairSystem system;
-  bt::DensePointToPlane{}.linearise(in, loss, weight, system);
+  bt::DensePointToPlane{}.linearise(in, T_i, T_j, loss, weight, system);
   return system;
 }
 
@@ -87,17 +88,15 @@ bt::PairSystem denseOnCpu(const bt::PairInput& in, const Loss& loss, double weig
 TEST_CASE("GPU dense kernel body on the host equals the CPU dense term for every loss") {
   const auto [frames, truth, camera] = syntheticFrames(7);
   const int step = 4;
-  const bt::Keyframe a = bt::makeKeyframe(0, frames[0], frames[0].mask, {}, truth[0], step);
-  const bt::Keyframe b = bt::makeKeyframe(7, frames[1], frames[1].mask, {}, truth[1], step);
-  const bt::PinholeCameraf grid = bt::downsampledCamera(camera, step);
+  const bt::Keyframe a = bt::makeKeyframe(0, frames[0], frames[0].mask, {}, truth[0], camera, step);
+  const bt::Keyframe b = bt::makeKeyframe(7, frames[1], frames[1].mask, {}, truth[1], camera, step);
   // Poses millimetres and a degree off the truth, so that residuals reach every loss's outer branch.
   const bt::SE3d nudge =
       bt::SE3d::exp((Eigen::Matrix<double, 6, 1>() << 0.006, -0.004, 0.008, 0.01, -0.015, 0.005).finished());
   const bt::SE3d T_b = nudge * truth[1];
-  const std::vector<bt::FeatureMatch> none;
-  const bt::PairInput input{a, b, truth[0], T_b, none, grid};
+  const bt::DensePointToPlane::Input input{a.surface, b.surface};
   const auto compare = [&](const auto& loss) {
-    const bt::PairSystem cpu = denseOnCpu(input, loss, 0.7), host = denseOnHost(input, loss, 0.7);
+    const bt::PairSystem cpu = denseOnCpu(input, truth[0], T_b, loss, 0.7), host = denseOnHost(input, truth[0], T_b, loss, 0.7);
     REQUIRE(cpu.residuals > 500);
     // Same cells, same gates: only the order of double sums differs (about 1e-16 per term over
     // a few thousand terms).
@@ -156,7 +155,7 @@ TEST_CASE("GPU RANSAC trial bodies on the host draw, fit and count as the CPU tr
   std::vector<bt::SE3d> cpu_fits;
   std::vector<char> cpu_valid;
   std::vector<int> cpu_scores;
-  bt::CpuTrialScorer(false).score(pairs, settings, gate, 0, trials, cpu_fits, cpu_valid, cpu_scores);
+  bt::CpuTrialScorer().score(pairs, settings, gate, 0, trials, cpu_fits, cpu_valid, cpu_scores);
   std::vector<float> packed;
   detail::packPairs(pairs, packed);
   int valid = 0, exact = 0, most = 0, fewest = int(pairs.size());
@@ -189,7 +188,7 @@ TEST_CASE("GPU RANSAC trial bodies on the host draw, fit and count as the CPU tr
   CHECK(fewest < most / 4);
 }
 
-TEST_CASE("GPU two-nearest kernel body on the host equals OpenCV's brute-force matcher (SIFT, ORB)") {
+TEST_CASE("GPU two-nearest kernel distances and update on the host equals OpenCV's brute-force matcher (SIFT, ORB)") {
   const FramePair pair = syntheticFrames(5);
   const std::vector<bt::RgbdFrame>& frames = pair.frames;
   const auto check = [](const bt::FrameFeatures& a, const bt::FrameFeatures& b, auto distance) {
@@ -198,13 +197,12 @@ TEST_CASE("GPU two-nearest kernel body on the host equals OpenCV's brute-force m
     REQUIRE(knn.size() == std::size_t(a.descriptors.rows));
     int same_index = 0;
     for (int q = 0; q < a.descriptors.rows; ++q) {
-      float best = INFINITY, second = INFINITY;
-      int nearest = -1;
-      for (int t = 0; t < b.descriptors.rows; ++t) detail::keepTwoNearest(distance(q, t), t, best, second, nearest);
+      bt::TwoNearest nearest;
+      for (int t = 0; t < b.descriptors.rows; ++t) nearest.offer(distance(q, t), t);
       const auto& expected = knn[std::size_t(q)];
-      same_index += nearest == expected[0].trainIdx;
-      CHECK(best == doctest::Approx(expected[0].distance).epsilon(1e-5));
-      CHECK(second == doctest::Approx(expected[1].distance).epsilon(1e-5));
+      same_index += nearest.index == expected[0].trainIdx;
+      CHECK(nearest.best == doctest::Approx(expected[0].distance).epsilon(1e-5));
+      CHECK(nearest.second == doctest::Approx(expected[1].distance).epsilon(1e-5));
     }
     // Indices differ only where two train rows tie to float rounding.
     CHECK(same_index >= int(0.99 * double(knn.size())));

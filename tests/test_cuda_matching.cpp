@@ -6,7 +6,7 @@
 #include "bundletrack/cuda/tracker.hpp"
 #include "bundletrack/eval/sequence_score.hpp"
 #include "bundletrack/synth/synthetic_sequence.hpp"
-#include "bundletrack/tracker.hpp"
+#include "bundletrack/default_tracker.hpp"
 
 namespace bt = bundletrack;
 namespace synth = bundletrack::synth;
@@ -82,7 +82,7 @@ TEST_CASE("tracker composed of GPU policies (PCG, matching, dense term, RANSAC) 
   const auto model = scene.objectMesh().sampleSurface(1000, 1);
   bt::SiftSettings sift;
   sift.matching.guided = false;  // the GPU matcher is exhaustive
-  bt::Tracker<bt::DefaultEnergy, bt::PCG, bt::SiftFeatures> cpu(camera, {}, {}, {}, bt::SiftFeatures(sift));
+  bt::DefaultTracker cpu(camera, {}, {}, {}, bt::SiftFeatures(sift));
   bt::cuda::Tracker<bt::SiftFeatures> gpu(
       camera, {}, {}, {}, bt::cuda::GpuMatched<bt::SiftFeatures>(bt::SiftFeatures(sift), sift.matching));
   std::vector<bt::SE3d> truth, on_cpu, on_gpu;

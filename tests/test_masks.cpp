@@ -83,8 +83,9 @@ TEST_CASE("propagated mask under the true pose matches the renderer's mask where
   const bt::RgbdFrame first = bt::makeFrame("0", f0.color, f0.depth, f0.mask, camera);
   bt::PropagatedMasks masks;
   masks.start(first, camera, f0.T_cam_obj, step);
-  const bt::Keyframe seen = bt::makeKeyframe(0, first, first.mask, {}, f0.T_cam_obj, step);
-  const std::vector<bt::ObservedSurface> object{{seen.points, f0.T_cam_obj}};
+  const bt::Keyframe seen = bt::makeKeyframe(0, first, first.mask, {}, f0.T_cam_obj, camera, step);
+  const bt::KeyframePool no_keyframes(2);
+  const bt::ObservedObject object({seen.surface.points, f0.T_cam_obj}, no_keyframes, 15);
   for (const int i : {1, 10, 19}) {  // up to ~30 degrees of rotation from the only view
     CAPTURE(i);
     const synth::SyntheticFrame f = scene.frame(i);
@@ -127,5 +128,6 @@ TEST_CASE("propagated masks refuse a first mask they cannot follow, and use befo
   mask(cv::Rect(12, 12, 10, 10)).setTo(255);  // only where the depth is invalid
   CHECK(problem(mask).find("no valid depth under the first mask") != std::string::npos);
   const bt::RgbdFrame later = bt::makeFrame("later", color, depth, cv::Mat(), camera);
-  CHECK_THROWS_AS(masks.mask(later, {}, bt::SE3d()), bt::InputError);
+  const bt::KeyframePool no_keyframes(2);
+  CHECK_THROWS_AS(masks.mask(later, bt::ObservedObject({}, no_keyframes, 15), bt::SE3d()), bt::InputError);
 }

@@ -12,6 +12,7 @@
 #include "bundletrack/solvers/dense_ldlt.hpp"
 #include "bundletrack/solvers/gauss_newton.hpp"
 #include "bundletrack/solvers/pcg.hpp"
+#include "pose_graph_fixture.hpp"
 #include "pose_graph_system.hpp"
 
 namespace bt = bundletrack;
@@ -32,8 +33,9 @@ bt::Keyframe surfaceKeyframe(int id, const bt::SE3d& T_cam_obj, const bt::Pinhol
   bt::Keyframe k;
   k.id = id;
   k.T_cam_obj = T_cam_obj;
-  k.points = cv::Mat(60, 80, CV_32FC3, cv::Scalar::all(0));
-  k.normals = cv::Mat(60, 80, CV_32FC3, cv::Scalar::all(0));
+  k.surface.points = cv::Mat(60, 80, CV_32FC3, cv::Scalar::all(0));
+  k.surface.normals = cv::Mat(60, 80, CV_32FC3, cv::Scalar::all(0));
+  k.surface.camera = grid;
   // Sampled by casting each grid ray.
   const bt::SE3d T_obj_cam = T_cam_obj.inverse();
   for (int v = 0; v < 60; ++v) {
@@ -53,15 +55,15 @@ bt::Keyframe surfaceKeyframe(int id, const bt::SE3d& T_cam_obj, const bt::Pinhol
       const Eigen::Vector3d n_obj = Eigen::Vector3d(-gradient(p).x(), -gradient(p).y(), 1.0).normalized();
       Eigen::Vector3d pc = T_cam_obj * p, nc = T_cam_obj.rotation() * n_obj;
       if (nc.dot(pc) > 0) nc = -nc;
-      k.points.at<cv::Vec3f>(v, u) = cv::Vec3f(float(pc.x()), float(pc.y()), float(pc.z()));
-      k.normals.at<cv::Vec3f>(v, u) = cv::Vec3f(float(nc.x()), float(nc.y()), float(nc.z()));
+      k.surface.points.at<cv::Vec3f>(v, u) = cv::Vec3f(float(pc.x()), float(pc.y()), float(pc.z()));
+      k.surface.normals.at<cv::Vec3f>(v, u) = cv::Vec3f(float(nc.x()), float(nc.y()), float(nc.z()));
       if (u % 7 == 0 && v % 7 == 0) {
         k.features.points.emplace_back(pc.cast<float>());
         k.features.normals.emplace_back(nc.cast<float>());
       }
     }
   }
-  bt::indexSurface(k);
+  bt::indexCells(k.surface);
   return k;
 }
 
@@ -74,28 +76,25 @@ std::vector<bt::SE3d> fourViews() {
   return views;
 }
 
-/// Every pair a < b of `nodes` graph nodes as an edge with the given feature correspondences.
-std::vector<bt::GraphEdge> allPairs(int nodes, const std::vector<bt::FeatureMatch>& matches) {
-  std::vector<bt::GraphEdge> edges;
-  for (int a = 0; a < nodes; ++a)
-    for (int b = a + 1; b < nodes; ++b) edges.push_back({a, b, &matches});
-  return edges;
-}
-
 /// The CPU dense term behind the batch interface, recording the size of every batch it is given.
 struct BatchedDense {
   bt::DensePointToPlane dense;
   std::shared_ptr<std::vector<std::size_t>> batches = std::make_shared<std::vector<std::size_t>>();
 
+  using Input = bt::DensePointToPlane::Input;
+  static Input input(const bt::EdgeView& edge) { return bt::DensePointToPlane::input(edge); }
+
   template <bt::RobustLoss Loss>
-  void linearise(const bt::PairInput& in, const Loss& loss, double weight, bt::PairSystem& system) const {
-    dense.linearise(in, loss, weight, system);
+  void linearise(const Input& in, const bt::SE3d& T_i, const bt::SE3d& T_j, const Loss& loss, double weight,
+                 bt::PairSystem& system) const {
+    dense.linearise(in, T_i, T_j, loss, weight, system);
   }
   template <bt::RobustLoss Loss>
-  void lineariseAll(std::span<const bt::PairInput> inputs, const Loss& loss, double weight,
-                    std::span<bt::PairSystem> systems) const {
+  void lineariseAll(std::span<const Input> inputs, std::span<const bt::GraphEdge> edges, std::span<const bt::SE3d> poses,
+                    const Loss& loss, double weight, std::span<bt::PairSystem> systems) const {
     batches->push_back(inputs.size());
-    for (std::size_t e = 0; e < inputs.size(); ++e) dense.linearise(inputs[e], loss, weight, systems[e]);
+    for (std::size_t e = 0; e < inputs.size(); ++e)
+      dense.linearise(inputs[e], poses[std::size_t(edges[e].i)], poses[std::size_t(edges[e].j)], loss, weight, systems[e]);
   }
 };
 static_assert(bt::BatchResidual<BatchedDense>);
@@ -144,9 +143,10 @@ TEST_CASE("feature and dense residual Jacobians equal central differences of the
   // The trivial loss makes H = J^T J and b = J^T r, so finite differences of the total cost
   // 1/2 sum r^2 must equal b, and H must be the Gauss-Newton matrix of the differenced residuals.
   const auto check = [&](const auto& residual) {
+    using R = std::decay_t<decltype(residual)>;
     const auto cost = [&](const bt::SE3d& A, const bt::SE3d& B) {
       bt::PairSystem system;
-      residual.linearise(bt::PairInput{ki, kj, A, B, matches, grid}, bt::TrivialLoss{}, 1.0, system);
+      residual.linearise(R::input(bt::EdgeView{ki, kj, matches}), A, B, bt::TrivialLoss{}, 1.0, system);
       return system;
     };
     const bt::PairSystem at = cost(Ti, Tj);
@@ -200,15 +200,13 @@ TEST_CASE("Gauss-Newton brings perturbed poses back to the truth, node 0 fixed")
   // Features correspond by index (the same grid cells see nearby, not identical, points), so only
   // the dense term is used here; it is exact up to the grid's sampling.
   const std::vector<bt::FeatureMatch> none;
-  std::vector<const bt::Keyframe*> nodes;
-  for (const auto& f : frames) nodes.push_back(&f);
-  const std::vector<bt::GraphEdge> edges = allPairs(4, none);
   std::vector<bt::SE3d> poses = truth;
   for (int k = 1; k < 4; ++k) poses[k] = perturbed(truth[k], rng, 0.004);
-  using DenseOnly = bt::Energy<bt::Term<bt::DensePointToPlane, bt::HuberLoss>>;
+  const bt::PoseGraph graph = allPairsGraph(frames, poses, none);
+  const bt::Energy<bt::Term<bt::DensePointToPlane, bt::HuberLoss>> dense_only;
   bt::GaussNewtonSettings settings;
   settings.iterations = 15;
-  const auto report = bt::optimizePoseGraph(DenseOnly{}, bt::DenseLDLT{}, nodes, edges, grid, poses, settings);
+  const auto report = bt::optimizePoseGraph(dense_only.over(graph), bt::DenseLDLT{}, poses, settings);
   CHECK(report.final_cost < report.initial_cost);
   CHECK((poses[0].matrix() - truth[0].matrix()).norm() == 0.0);
   for (int k = 1; k < 4; ++k) {
@@ -216,6 +214,39 @@ TEST_CASE("Gauss-Newton brings perturbed poses back to the truth, node 0 fixed")
     // A paraboloid constrains all six degrees of freedom; residual error comes from the 4 mm grid.
     CHECK((poses[k].translation() - truth[k].translation()).norm() < 1e-3);
     CHECK(bt::rotationGeodesic(poses[k].rotation(), truth[k].rotation()) * 180.0 / 3.14159 < 0.2);
+  }
+}
+
+TEST_CASE("Levenberg-Marquardt step control never takes a step that raises the energy and reaches the truth") {
+  std::mt19937 rng(5);
+  const bt::PinholeCameraf grid{150.0f, 150.0f, 39.5f, 29.5f};
+  const std::vector<bt::SE3d> truth = fourViews();
+  std::vector<bt::Keyframe> frames;
+  for (int k = 0; k < 4; ++k) frames.push_back(surfaceKeyframe(k, truth[std::size_t(k)], grid));
+  const std::vector<bt::FeatureMatch> none;
+  std::vector<bt::SE3d> start = truth;
+  for (int k = 1; k < 4; ++k) start[k] = perturbed(truth[k], rng, 0.006);
+  const bt::PoseGraph graph = allPairsGraph(frames, start, none);
+  const bt::Energy<bt::Term<bt::DensePointToPlane, bt::HuberLoss>> dense_only;
+  bt::GaussNewtonSettings settings;
+  settings.iterations = 20;
+  std::vector<bt::SE3d> plain = start, damped = start;
+  const auto gauss_newton = bt::optimizePoseGraph(dense_only.over(graph), bt::DenseLDLT{}, plain, settings);
+  settings.step_control = bt::StepControl::LevenbergMarquardt;
+  const auto levenberg = bt::optimizePoseGraph(dense_only.over(graph), bt::DenseLDLT{}, damped, settings);
+  // Every step is solved and reported; plain Gauss-Newton takes each one.
+  CHECK(int(gauss_newton.solves.size()) == gauss_newton.iterations);
+  CHECK(gauss_newton.rejected_steps == 0);
+  CHECK(int(levenberg.solves.size()) >= levenberg.iterations);
+  CHECK(levenberg.final_cost <= levenberg.initial_cost);
+  // An accepted step lowers the energy: the energy of the result, evaluated afresh, is the last one.
+  bt::Linearisation at_result;
+  bt::assembleNormalEquations(dense_only.over(graph), damped, at_result);
+  CHECK(at_result.cost == doctest::Approx(levenberg.final_cost).epsilon(1e-12));
+  for (int k = 1; k < 4; ++k) {
+    CAPTURE(k);
+    CHECK((damped[k].translation() - truth[k].translation()).norm() < 1e-3);
+    CHECK(bt::rotationGeodesic(damped[k].rotation(), truth[k].rotation()) * 180.0 / 3.14159 < 0.2);
   }
 }
 
@@ -234,26 +265,29 @@ TEST_CASE("a batch residual gets every edge of the graph in one call and adds wh
   for (const auto& f : frames) common = std::min(common, f.features.size());
   std::vector<bt::FeatureMatch> matches;
   for (int f = 0; f < int(common); ++f) matches.push_back({f, f});
-  std::vector<const bt::Keyframe*> nodes;
-  for (const auto& f : frames) nodes.push_back(&f);
-  const std::vector<bt::GraphEdge> edges = allPairs(4, matches);
-  using EdgeWise = bt::Energy<bt::Term<bt::FeaturePointToPoint, bt::HuberLoss>, bt::Term<bt::DensePointToPlane, bt::HuberLoss>>;
-  using Batched = bt::Energy<bt::Term<bt::FeaturePointToPoint, bt::HuberLoss>, bt::Term<BatchedDense, bt::HuberLoss>>;
-  const Batched batched;
-  Eigen::MatrixXd H_edge, H_batch;
-  Eigen::VectorXd b_edge, b_batch;
-  int residuals_edge = 0, residuals_batch = 0;
-  const double cost_edge = bt::assembleNormalEquations(EdgeWise{}, nodes, edges, grid, poses, H_edge, b_edge, residuals_edge);
-  const double cost_batch = bt::assembleNormalEquations(batched, nodes, edges, grid, poses, H_batch, b_batch, residuals_batch);
-  REQUIRE(residuals_edge > 1000);
+  const bt::PoseGraph graph = allPairsGraph(frames, poses, matches);
+  const bt::Energy<bt::Term<bt::FeaturePointToPoint, bt::HuberLoss>, bt::Term<bt::DensePointToPlane, bt::HuberLoss>> edge_wise;
+  const bt::Energy<bt::Term<bt::FeaturePointToPoint, bt::HuberLoss>, bt::Term<BatchedDense, bt::HuberLoss>> batched;
+  bt::Linearisation by_edge, by_batch;
+  bt::assembleNormalEquations(edge_wise.over(graph), poses, by_edge);
+  bt::assembleNormalEquations(batched.over(graph), poses, by_batch);
+  REQUIRE(by_edge.residuals > 1000);
   // Per edge the terms add in the same order, so the sums are the same to the last bit.
-  CHECK(residuals_batch == residuals_edge);
-  CHECK(cost_batch == cost_edge);
-  CHECK(H_batch == H_edge);
-  CHECK(b_batch == b_edge);
+  CHECK(by_batch.residuals == by_edge.residuals);
+  CHECK(by_batch.cost == by_edge.cost);
+  CHECK(by_batch.H == by_edge.H);
+  CHECK(by_batch.b == by_edge.b);
   const auto& batches = *std::get<1>(batched.terms).residual.batches;
   REQUIRE(batches.size() == 1);
-  CHECK(batches[0] == edges.size());
+  CHECK(batches[0] == graph.edges.size());
+  // Serial and parallel linearisation give the same system, bit for bit.
+  bt::Energy<bt::Term<bt::FeaturePointToPoint, bt::HuberLoss>, bt::Term<bt::DensePointToPlane, bt::HuberLoss>> serial;
+  serial.execution = bt::Execution::Serial;
+  bt::Linearisation one_thread;
+  bt::assembleNormalEquations(serial.over(graph), poses, one_thread);
+  CHECK(one_thread.H == by_edge.H);
+  CHECK(one_thread.b == by_edge.b);
+  CHECK(one_thread.cost == by_edge.cost);
 }
 
 TEST_CASE("keyframe pool: greedy selection keeps frame 0 and follows the geodesic sums, and the pool is bounded") {

@@ -101,7 +101,7 @@ TEST_CASE("RANSAC is deterministic and independent of parallel scoring") {
   auto matches = identityMatches(100);
   for (int i = 0; i < 50; ++i) matches[i].second = (i + 7) % 100;
   bt::RansacSettings serial;
-  serial.parallel = false;
+  serial.execution = bt::Execution::Serial;
   const auto a = bt::Ransac().estimate(first, second, matches), b = bt::Ransac(serial).estimate(first, second, matches);
   CHECK(a.inliers == b.inliers);
   CHECK(a.trials == b.trials);

@@ -4,7 +4,9 @@
 #include "bundletrack/eval/mask_iou.hpp"
 #include "bundletrack/eval/sequence_score.hpp"
 #include "bundletrack/synth/synthetic_sequence.hpp"
-#include "bundletrack/tracker.hpp"
+#include "bundletrack/default_tracker.hpp"
+#include "bundletrack/masks/propagated_masks.hpp"
+#include "bundletrack/solvers/dense_ldlt.hpp"
 
 namespace bt = bundletrack;
 namespace synth = bundletrack::synth;
@@ -49,7 +51,7 @@ TEST_CASE("full tracker on a synthetic hand-held box: ADD-S AUC >= 95 and less d
   const synth::SyntheticScene scene(settings);
   const auto model = scene.objectMesh().sampleSurface(1000, 1);
   const Run full = track(bt::DefaultTracker(settings.camera.cast<float>()), scene, model);
-  const Run coarse = track(bt::CoarseTracker<>(), scene, model);
+  const Run coarse = track(bt::DefaultCoarseTracker(), scene, model);
   MESSAGE("full:   ADD " << full.score.add_auc << " ADD-S " << full.score.adds_auc << " final ADD "
                          << full.score.final_add_cm << " cm, tracked " << full.tracked);
   MESSAGE("coarse: ADD " << coarse.score.add_auc << " ADD-S " << coarse.score.adds_auc << " final ADD "
@@ -69,7 +71,8 @@ TEST_CASE("from the first mask alone: propagated masks track the hand-held box a
   const auto model = scene.objectMesh().sampleSurface(1000, 1);
   const auto camera = settings.camera.cast<float>();
   const Run given = track(bt::DefaultTracker(camera), scene, model);
-  using Propagated = bt::Tracker<bt::DefaultEnergy, bt::PCG, bt::SiftFeatures, bt::PropagatedMasks>;
+  using Propagated = bt::Tracker<bt::DefaultEnergy, bt::PCG, bt::SiftFeatures, bt::PropagatedMasks, bt::Ransac,
+                                 bt::SurfaceAgreement>;
   const Run propagated = track(Propagated(camera), scene, model, true);
   MESSAGE("given masks: ADD-S " << given.score.adds_auc << "; propagated: ADD-S " << propagated.score.adds_auc
                                 << ", mean mask IoU " << propagated.mean_mask_iou);
@@ -90,7 +93,8 @@ TEST_CASE("feature-only and dense-only energies compose and track, and dense alo
   const Run full = track(bt::DefaultTracker(settings.camera.cast<float>()), scene, model);
   MESSAGE("textureless can: ADD-S " << full.score.adds_auc << ", lost " << full.lost);
   CHECK(full.score.adds_auc >= 90.0);
-  using FeatureOnly = bt::Tracker<bt::Energy<bt::Term<bt::FeaturePointToPoint, bt::HuberLoss>>, bt::DenseLDLT>;
+  using FeatureOnly = bt::Tracker<bt::Energy<bt::Term<bt::FeaturePointToPoint, bt::HuberLoss>>, bt::DenseLDLT,
+                                  bt::SiftFeatures, bt::GivenMasks, bt::Ransac, bt::SurfaceAgreement>;
   synth::SyntheticSequenceSettings box = settings;
   box.shape = synth::Shape::Box;
   box.textureless = false;
@@ -158,5 +162,6 @@ TEST_CASE("object out of view for 30 frames, given masks: lost while gone, recov
 }
 
 TEST_CASE("object out of view for 30 frames, first mask only: lost while gone, found again on return") {
-  checkOutOfView<bt::Tracker<bt::DefaultEnergy, bt::PCG, bt::SiftFeatures, bt::PropagatedMasks>>(true);
+  checkOutOfView<bt::Tracker<bt::DefaultEnergy, bt::PCG, bt::SiftFeatures, bt::PropagatedMasks, bt::Ransac,
+                             bt::SurfaceAgreement>>(true);
 }

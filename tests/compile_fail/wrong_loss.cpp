@@ -1,5 +1,5 @@
 // Must not compile: a Term whose loss has no evaluate(s). The CMake test expects the concept's name.
-#include "bundletrack/tracker.hpp"
+#include "bundletrack/default_tracker.hpp"
 
 struct NotALoss {};
 

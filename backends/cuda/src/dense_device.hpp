@@ -2,6 +2,8 @@
 
 // The boundary between host code and the CUDA translation unit: plain data and pointers only.
 
+#include "bundletrack/robust/loss_kind.hpp"
+
 namespace bundletrack::cuda::detail {
 
 /// A keyframe's dense grid on the device (owned by the .cu side).
@@ -17,9 +19,9 @@ void releaseGrid(DeviceGrid* grid);
 struct DirectedPass {
   double T_t_s[12], T_s_t[12], T_s_inv[12], T_t_inv[12];
   double cos_max, max_sq;
-  float fx, fy, cx, cy;
-  int loss_kind;
-  double loss_parameter, weight;
+  float fx, fy, cx, cy;  ///< t's grid camera
+  LossParameters loss;
+  double weight;
 };
 
 /// The sums of a pass over its cells: w J^T J (36, row-major), w r J (6), the weighted losses and

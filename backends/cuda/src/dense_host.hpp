@@ -3,8 +3,6 @@
 // What the host hands the dense kernel: a directed pass's parameters and a keyframe's surface
 // cells, in the plain layout of dense_device.hpp.
 
-#include <cmath>
-#include <numbers>
 #include <vector>
 
 #include "bundletrack/cuda/dense_point_to_plane.hpp"
@@ -18,21 +16,20 @@ inline void rowMajor3x4(const SE3d& T, double out[12]) {
     for (int c = 0; c < 4; ++c) out[4 * r + c] = M(r, c);
 }
 
-/// The pass s -> t of an edge whose nodes have poses T_s, T_t (object in camera), with the gates
-/// of DensePointToPlane.
-inline DirectedPass directedPass(const SE3d& T_s, const SE3d& T_t, const PinholeCameraf& grid_camera,
-                                 float max_distance, float max_normal_angle_deg, const LossParameters& loss,
-                                 double weight) {
+/// The pass s -> t of an edge whose nodes have poses T_s, T_t (object in camera), with the gate of
+/// DensePointToPlane and t's grid camera.
+inline DirectedPass directedPass(const SE3d& T_s, const SE3d& T_t, const PinholeCameraf& t_camera, const SurfaceGate& gate,
+                                 const LossParameters& loss, double weight) {
   DirectedPass p{};
   rowMajor3x4(T_t * T_s.inverse(), p.T_t_s);
   rowMajor3x4(T_s * T_t.inverse(), p.T_s_t);
   rowMajor3x4(T_s.inverse(), p.T_s_inv);
   rowMajor3x4(T_t.inverse(), p.T_t_inv);
-  p.cos_max = std::cos(double(max_normal_angle_deg) * std::numbers::pi / 180.0);
-  p.max_sq = double(max_distance) * double(max_distance);
-  p.fx = grid_camera.fx, p.fy = grid_camera.fy, p.cx = grid_camera.cx, p.cy = grid_camera.cy;
-  p.loss_kind = int(loss.kind);
-  p.loss_parameter = loss.parameter;
+  const SurfaceGate::Bounds<double> bounds = gate.bounds<double>();
+  p.cos_max = bounds.cos_max_angle;
+  p.max_sq = bounds.max_squared_distance;
+  p.fx = t_camera.fx, p.fy = t_camera.fy, p.cx = t_camera.cx, p.cy = t_camera.cy;
+  p.loss = loss;
   p.weight = weight;
   return p;
 }
@@ -45,10 +42,10 @@ inline void addPassSums(const double sums[kDenseSums], bool swapped, PairSystem&
                          sums[42], int(sums[43] + 0.5));
 }
 
-/// Row-major indices of a keyframe's surface cells in its grid.
-inline std::vector<int> surfaceCells(const Keyframe& k) {
-  std::vector<int> cells(k.surface.size());
-  for (std::size_t i = 0; i < cells.size(); ++i) cells[i] = k.surface[i].y * k.points.cols + k.surface[i].x;
+/// Row-major indices of a grid's surface cells.
+inline std::vector<int> surfaceCells(const SurfaceGrid& grid) {
+  std::vector<int> cells(grid.cells.size());
+  for (std::size_t i = 0; i < cells.size(); ++i) cells[i] = grid.cells[i].y * grid.points.cols + grid.cells[i].x;
   return cells;
 }
 

@@ -13,9 +13,9 @@ namespace bundletrack::cuda {
 
 namespace {
 
-/// Tells a keyframe's grid from another that took its id or its memory: FNV-1a over the data
-/// pointer, the sizes and the first and last surface points.
-std::uint64_t signature(const Keyframe& k) {
+/// Tells a surface grid from another: FNV-1a over the data pointer, the sizes and the first and
+/// last surface points (a grid whose memory another took differs in its points).
+std::uint64_t signature(const SurfaceGrid& k) {
   std::uint64_t h = 1469598103934665603ull;
   const auto mix = [&](const void* data, std::size_t bytes) {
     const auto* p = static_cast<const unsigned char*>(data);
@@ -23,11 +23,11 @@ std::uint64_t signature(const Keyframe& k) {
   };
   const void* data = k.points.data;
   mix(&data, sizeof(data));
-  const int sizes[3] = {k.points.rows, k.points.cols, int(k.surface.size())};
+  const int sizes[3] = {k.points.rows, k.points.cols, int(k.cells.size())};
   mix(sizes, sizeof(sizes));
-  const std::size_t n = k.surface.size(), ends = std::min<std::size_t>(n, 16);
-  for (std::size_t i = 0; i < ends; ++i) mix(&k.points.at<cv::Vec3f>(k.surface[i]), sizeof(cv::Vec3f));
-  for (std::size_t i = n - ends; i < n; ++i) mix(&k.points.at<cv::Vec3f>(k.surface[i]), sizeof(cv::Vec3f));
+  const std::size_t n = k.cells.size(), ends = std::min<std::size_t>(n, 16);
+  for (std::size_t i = 0; i < ends; ++i) mix(&k.points.at<cv::Vec3f>(k.cells[i]), sizeof(cv::Vec3f));
+  for (std::size_t i = n - ends; i < n; ++i) mix(&k.points.at<cv::Vec3f>(k.cells[i]), sizeof(cv::Vec3f));
   return h;
 }
 
@@ -38,12 +38,11 @@ struct DensePointToPlane::Workspace {
 
   struct Entry {
     detail::DeviceGrid* grid;
-    std::uint64_t signature;
     std::uint64_t last_use;
   };
 
   std::mutex mutex;  // one batch at a time touches the device state
-  std::map<int, Entry> grids;
+  std::map<std::uint64_t, Entry> grids;  ///< by signature
   detail::DeviceBatch* batch = detail::createBatch();
   std::vector<detail::BatchPass> passes;
   std::vector<double> sums;
@@ -54,19 +53,11 @@ struct DensePointToPlane::Workspace {
     detail::releaseBatch(batch);
   }
 
-  /// k's grid on the device, uploaded when absent or changed. Evicts the least recently used grid
-  /// beyond kCapacity, never one the current batch reads (the cache then holds more for a while).
-  const detail::DeviceGrid* grid(const Keyframe& k) {
+  /// k on the device, uploaded when not there yet. Evicts the least recently used grid beyond
+  /// kCapacity, never one the current batch reads (the cache then holds more for a while).
+  const detail::DeviceGrid* grid(const SurfaceGrid& k) {
     const std::uint64_t sig = signature(k);
-    auto found = grids.find(k.id);
-    if (found != grids.end() && found->second.signature != sig) {
-      if (found->second.last_use == batch_clock)
-        throw std::logic_error("cuda::DensePointToPlane: two different grids with keyframe id " + std::to_string(k.id) +
-                               " in one graph");
-      detail::releaseGrid(found->second.grid);
-      grids.erase(found);
-      found = grids.end();
-    }
+    auto found = grids.find(sig);
     if (found == grids.end()) {
       if (grids.size() >= kCapacity) {
         auto oldest = grids.end();
@@ -81,9 +72,9 @@ struct DensePointToPlane::Workspace {
       const cv::Mat points = k.points.isContinuous() ? k.points : k.points.clone();
       const cv::Mat normals = k.normals.isContinuous() ? k.normals : k.normals.clone();
       const std::vector<int> cells = detail::surfaceCells(k);
-      found = grids.emplace(k.id, Entry{detail::uploadGrid(points.ptr<float>(), normals.ptr<float>(), points.cols,
-                                                            points.rows, cells.data(), int(cells.size())),
-                                        sig, 0})
+      found = grids.emplace(sig, Entry{detail::uploadGrid(points.ptr<float>(), normals.ptr<float>(), points.cols,
+                                                          points.rows, cells.data(), int(cells.size())),
+                                      0})
                   .first;
     }
     found->second.last_use = batch_clock;
@@ -93,25 +84,26 @@ struct DensePointToPlane::Workspace {
 
 DensePointToPlane::DensePointToPlane() : workspace_(std::make_shared<Workspace>()) {}
 
-void DensePointToPlane::lineariseAllWith(std::span<const PairInput> inputs, const LossParameters& loss, double weight,
+void DensePointToPlane::lineariseAllWith(std::span<const Input> inputs, std::span<const GraphEdge> edges,
+                                         std::span<const SE3d> poses, const LossParameters& loss, double weight,
                                          std::span<PairSystem> systems) const {
-  if (systems.size() != inputs.size())
-    throw std::invalid_argument("cuda::DensePointToPlane::lineariseAll: " + std::to_string(inputs.size()) +
-                                " edges but " + std::to_string(systems.size()) + " systems");
+  if (systems.size() != inputs.size() || edges.size() != inputs.size())
+    throw std::invalid_argument("cuda::DensePointToPlane::lineariseAll: " + std::to_string(inputs.size()) + " inputs, " +
+                                std::to_string(edges.size()) + " edges and " + std::to_string(systems.size()) +
+                                " systems");
   Workspace& w = *workspace_;
   const std::lock_guard lock(w.mutex);
   ++w.batch_clock;
   // Passes 2e and 2e + 1 are edge e's directions i -> j and j -> i.
   w.passes.clear();
-  for (const PairInput& in : inputs) {
+  for (std::size_t e = 0; e < inputs.size(); ++e) {
+    const Input& in = inputs[e];
+    const SE3d& T_i = poses[std::size_t(edges[e].i)];
+    const SE3d& T_j = poses[std::size_t(edges[e].j)];
     const detail::DeviceGrid* grid_i = w.grid(in.i);
     const detail::DeviceGrid* grid_j = w.grid(in.j);
-    w.passes.push_back({grid_i, grid_j,
-                        detail::directedPass(in.T_i, in.T_j, in.grid_camera, max_distance, max_normal_angle_deg, loss,
-                                             weight)});
-    w.passes.push_back({grid_j, grid_i,
-                        detail::directedPass(in.T_j, in.T_i, in.grid_camera, max_distance, max_normal_angle_deg, loss,
-                                             weight)});
+    w.passes.push_back({grid_i, grid_j, detail::directedPass(T_i, T_j, in.j.camera, gate, loss, weight)});
+    w.passes.push_back({grid_j, grid_i, detail::directedPass(T_j, T_i, in.i.camera, gate, loss, weight)});
   }
   w.sums.resize(w.passes.size() * detail::kDenseSums);
   detail::accumulateDense(*w.batch, w.passes.data(), int(w.passes.size()), w.sums.data());

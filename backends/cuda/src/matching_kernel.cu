@@ -2,6 +2,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "bundletrack/features/two_nearest.hpp"
 #include "device_memory.hpp"
 #include "matching_device.hpp"
 #include "matching_metric.hpp"
@@ -22,8 +23,7 @@ __global__ void twoNearestKernel(const Word* query, int queries, const Word* tra
   extern __shared__ unsigned char shared[];
   Word* tile = reinterpret_cast<Word*>(shared);
   const int q = blockIdx.x * blockDim.x + threadIdx.x;
-  float b = INFINITY, s = INFINITY;
-  int nearest = -1;
+  TwoNearest nearest;
   for (int start = 0; start < trains; start += kTile) {
     const int count = min(kTile, trains - start);
     for (int k = threadIdx.x; k < count * width; k += blockDim.x) tile[k] = train[start * width + k];
@@ -31,12 +31,12 @@ __global__ void twoNearestKernel(const Word* query, int queries, const Word* tra
     if (q < queries) {
       for (int t = 0; t < count; ++t) {
         const float d = Metric::distance(query + q * width, tile + t * width, width);
-        keepTwoNearest(d, start + t, b, s, nearest);
+        nearest.offer(d, start + t);
       }
     }
     __syncthreads();
   }
-  if (q < queries) index[q] = nearest, best[q] = b, second[q] = s;
+  if (q < queries) index[q] = nearest.index, best[q] = nearest.best, second[q] = nearest.second;
 }
 
 }  // namespace

@@ -1,6 +1,6 @@
 #pragma once
 
-// The distances and the two-nearest update of the GPU matching kernel, host and device.
+// The descriptor distances of the GPU matching kernel, host and device.
 
 #include <cmath>
 #include <cstdint>
@@ -34,12 +34,5 @@ struct Hamming {
     return float(bits);
   }
 };
-
-/// Keeps the nearest (`best`, its train row `nearest`) and second-nearest distances seen so far;
-/// rows come in increasing order, so a tie keeps the lower index, as the CPU matcher does.
-BUNDLETRACK_HOST_DEVICE inline void keepTwoNearest(float d, int row, float& best, float& second, int& nearest) {
-  if (d < best) second = best, best = d, nearest = row;
-  else if (d < second) second = d;
-}
 
 }  // namespace bundletrack::cuda::detail

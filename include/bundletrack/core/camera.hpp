@@ -3,6 +3,7 @@
 #include <Eigen/Core>
 
 #include "bundletrack/core/macros.hpp"
+#include "bundletrack/core/pixel.hpp"
 
 namespace bundletrack {
 
@@ -19,6 +20,13 @@ struct PinholeCamera {
 
   BUNDLETRACK_HOST_DEVICE Vector2 project(const Vector3& p) const {
     return Vector2(fx * p.x() / p.z() + cx, fy * p.y() / p.z() + cy);
+  }
+
+  /// The pixel (u, v) that camera-frame point p projects into (projectToPixel, in p's scalar
+  /// type); false for a point on or behind the image plane.
+  template <typename Derived>
+  bool pixelOf(const Eigen::MatrixBase<Derived>& p, int& u, int& v) const {
+    return projectToPixel(fx, fy, cx, cy, p.x(), p.y(), p.z(), u, v);
   }
 
   /// The camera-frame point seen at pixel (u, v) with depth z (metres along the optical axis).

@@ -1,10 +1,11 @@
 #pragma once
 
-#include <cmath>
 #include <vector>
 
 #include <Eigen/Core>
 #include <opencv2/core.hpp>
+
+#include "bundletrack/core/camera.hpp"
 
 namespace bundletrack {
 
@@ -26,7 +27,7 @@ inline std::vector<int> keepFeaturesInside(FrameFeatures& features, const cv::Ma
   std::vector<int> kept(features.size(), -1);
   int count = 0;
   for (std::size_t k = 0; k < features.size(); ++k) {
-    const int u = int(std::lround(features.pixels[k].x)), v = int(std::lround(features.pixels[k].y));
+    const int u = roundToPixel(features.pixels[k].x), v = roundToPixel(features.pixels[k].y);
     if (u < 0 || v < 0 || u >= mask.cols || v >= mask.rows || !mask.at<uchar>(v, u)) continue;
     features.pixels[std::size_t(count)] = features.pixels[k];
     features.points[std::size_t(count)] = features.points[k];

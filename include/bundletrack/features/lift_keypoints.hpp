@@ -47,7 +47,7 @@ inline FrameFeatures liftKeypoints(const RgbdFrame& frame, const std::vector<cv:
   features.norm_type = norm_type;
   std::vector<int> kept;
   for (std::size_t k = 0; k < pixels.size(); ++k) {
-    const int u = int(std::lround(pixels[k].x)), v = int(std::lround(pixels[k].y));
+    const int u = roundToPixel(pixels[k].x), v = roundToPixel(pixels[k].y);
     if (u < 0 || v < 0 || u >= frame.depth.cols || v >= frame.depth.rows) continue;
     const cv::Vec3f& p = frame.points.at<cv::Vec3f>(v, u);
     if (p[2] <= 0.0f) continue;

@@ -1,14 +1,15 @@
 #pragma once
 
 #include <cmath>
-#include <numbers>
 #include <optional>
 #include <vector>
 
 #include <opencv2/features2d.hpp>
 
 #include "bundletrack/core/se3.hpp"
+#include "bundletrack/core/surface_gate.hpp"
 #include "bundletrack/features/frame_features.hpp"
+#include "bundletrack/features/two_nearest.hpp"
 
 namespace bundletrack {
 
@@ -21,13 +22,11 @@ struct MatchSettings {
   bool guided = true;
 };
 
-/// Geometric gate for a pair whose relative pose is already known (DESIGN.md section 3: 2 cm and
-/// 45 degrees for non-consecutive pairs): a match survives when the first point, moved by
-/// T_second_first, lies within max_distance of the second and their normals within the angle.
+/// Geometric gate for a pair whose relative pose is already known (docs/DESIGN.md section 3): a
+/// match survives when the first point, moved by T_second_first, and the second pass `surface`.
 struct MatchGate {
   SE3f T_second_first;
-  float max_distance = 0.02f;  ///< metres
-  float max_normal_angle_deg = 45.0f;
+  SurfaceGate surface;
 };
 
 /// Distance between descriptor rows a and b (CV_32F rows under NORM_L2, CV_8U rows under NORM_HAMMING).
@@ -42,26 +41,12 @@ inline float descriptorDistance(const cv::Mat& a, const cv::Mat& b, int norm_typ
   return float(cv::norm(a, b, norm_type));
 }
 
-/// The nearest and second-nearest candidate of one keypoint (index -1: none yet).
-struct TwoNearest {
-  int index = -1;
-  float best = INFINITY, second = INFINITY;
-
-  void offer(float distance, int candidate) {
-    if (distance < best) second = best, best = distance, index = candidate;
-    else if (distance < second) second = distance;
-  }
-  /// Lowe's ratio test; a lone candidate passes.
-  bool distinct(float ratio) const { return index >= 0 && best < ratio * second; }
-};
-
 /// A MatchGate ready to test pairs: first's keypoint moved into the second frame once, then
 /// compared with any of second's.
 class GateTest {
  public:
   GateTest(const MatchGate& gate, const FrameFeatures& first, const FrameFeatures& second)
-      : gate_(gate), first_(first), second_(second), max_squared_distance_(gate.max_distance * gate.max_distance),
-        cos_max_angle_(std::cos(gate.max_normal_angle_deg * std::numbers::pi_v<float> / 180.0f)) {}
+      : gate_(gate), first_(first), second_(second), bounds_(gate.surface.bounds<float>()) {}
 
   struct Moved {
     Eigen::Vector3f point, normal;
@@ -71,15 +56,15 @@ class GateTest {
             gate_.T_second_first.rotation() * first_.normals[std::size_t(i)]};
   }
   bool admits(const Moved& moved, int j) const {
-    return (moved.point - second_.points[std::size_t(j)]).squaredNorm() <= max_squared_distance_ &&
-           moved.normal.dot(second_.normals[std::size_t(j)]) >= cos_max_angle_;
+    return bounds_.admits((moved.point - second_.points[std::size_t(j)]).squaredNorm(),
+                          moved.normal.dot(second_.normals[std::size_t(j)]));
   }
 
  private:
   const MatchGate& gate_;
   const FrameFeatures& first_;
   const FrameFeatures& second_;
-  float max_squared_distance_, cos_max_angle_;
+  SurfaceGate::Bounds<float> bounds_;
 };
 
 /// Pairs that are each other's distinct nearest neighbour (forward[i]: first's keypoint i among

@@ -48,7 +48,7 @@ class OpenCvFeatureSource {
       // Detection sees the dilated mask (descriptors need the object's outline), but a keypoint
       // off the object would lift onto the background: keep only those inside the mask itself.
       const cv::Point2f pixel = crop.toImage(keypoints[order[k]].pt);
-      const int u = int(std::lround(pixel.x)), v = int(std::lround(pixel.y));
+      const int u = roundToPixel(pixel.x), v = roundToPixel(pixel.y);
       if (u < 0 || v < 0 || u >= frame.mask.cols || v >= frame.mask.rows || !frame.mask.at<uchar>(v, u)) continue;
       pixels.push_back(pixel);
       descriptors.row(order[k]).copyTo(strongest.row(kept++));

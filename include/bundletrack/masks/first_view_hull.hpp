@@ -41,9 +41,8 @@ class FirstViewHull {
 
   bool contains(const Eigen::Vector3d& p_obj) const {
     const Eigen::Vector3f p = (T_cam_obj_ * p_obj).cast<float>();
-    if (p.z() <= 0.0f) return false;
-    const int u = int(std::lround(camera_.fx * p.x() / p.z() + camera_.cx));
-    const int v = int(std::lround(camera_.fy * p.y() / p.z() + camera_.cy));
+    int u = 0, v = 0;
+    if (!camera_.pixelOf(p, u, v)) return false;
     if (u < 0 || v < 0 || u >= mask_.cols || v >= mask_.rows || !mask_.at<uchar>(v, u)) return false;
     const float seen = depth_.at<float>(v, u);
     return seen <= 0.0f || (p.z() >= seen - depth_tolerance_ && p.z() <= seen + extent_);

@@ -1,13 +1,29 @@
 #pragma once
 
+#include <optional>
+
 #include "bundletrack/core/error.hpp"
 #include "bundletrack/masks/mask_source.hpp"
 
 namespace bundletrack {
 
-/// Masks that come with the data (the frame's own mask, e.g. from masks/<name>.png).
+/// Masks that come with the data (the frame's own mask, e.g. from masks/<name>.png): the same
+/// mask whatever the tracker knows.
 struct GivenMasks {
-  cv::Mat mask(const RgbdFrame& frame) const {
+  cv::Mat start(const RgbdFrame& first, const PinholeCameraf&, const SE3d&, int) {
+    if (first.mask.empty() || cv::countNonZero(first.mask) == 0)
+      throw InputError("frame " + first.name, "the first frame needs a non-empty object mask");
+    return first.mask;
+  }
+
+  cv::Mat searchRegion(const RgbdFrame& frame, const ObservedObject&, const std::optional<SE3d>&) const {
+    return mask(frame);
+  }
+
+  cv::Mat mask(const RgbdFrame& frame, const ObservedObject&, const SE3d&) const { return mask(frame); }
+
+ private:
+  static cv::Mat mask(const RgbdFrame& frame) {
     if (frame.mask.empty())
       throw InputError("frame " + frame.name, "no object mask: tracking with given masks needs one for every frame");
     return frame.mask;

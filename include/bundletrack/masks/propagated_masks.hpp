@@ -2,14 +2,13 @@
 
 #include <cmath>
 #include <optional>
-#include <span>
 #include <vector>
 
 #include <opencv2/core.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include "bundletrack/core/error.hpp"
-#include "bundletrack/graph/keyframe.hpp"
+#include "bundletrack/core/surface_grid.hpp"
 #include "bundletrack/masks/depth_segments.hpp"
 #include "bundletrack/masks/first_view_hull.hpp"
 #include "bundletrack/masks/mask_source.hpp"
@@ -51,7 +50,7 @@ class PropagatedMasks {
 
   explicit PropagatedMasks(Settings settings = {}) : settings_(settings) {}
 
-  void start(const RgbdFrame& first, const PinholeCameraf& camera, const SE3d& T_cam_obj, int grid_step) {
+  cv::Mat start(const RgbdFrame& first, const PinholeCameraf& camera, const SE3d& T_cam_obj, int grid_step) {
     if (first.mask.empty() || cv::countNonZero(first.mask) == 0)
       throw InputError("frame " + first.name, "propagated masks need a non-empty mask of the first frame");
     camera_ = camera;
@@ -63,23 +62,23 @@ class PropagatedMasks {
       throw InputError("frame " + first.name, "no valid depth under the first mask: nothing to propagate it from");
     first_depth_ = float(cv::mean(first.depth, seen)[0]);
     started_ = true;
+    return first.mask;
   }
 
-  cv::Mat searchRegion(const RgbdFrame& frame, std::span<const ObservedSurface> object,
-                       const std::optional<SE3d>& T_guess) const {
+  cv::Mat searchRegion(const RgbdFrame& frame, const ObservedObject& object, const std::optional<SE3d>& T_guess) const {
     requireStarted(frame);
     if (!T_guess) return objectSizedSurfaces(frame);
-    cv::Mat silhouette = renderDepth(object, *T_guess, gridSize(frame)) > 0.0f;
+    cv::Mat silhouette = renderDepth(object.surfaces(*T_guess), *T_guess, gridSize(frame)) > 0.0f;
     const int margin = (settings_.search_margin_px + grid_step_ - 1) / grid_step_;
     cv::dilate(silhouette, silhouette, cv::getStructuringElement(cv::MORPH_ELLIPSE, {2 * margin + 1, 2 * margin + 1}));
     cv::resize(silhouette, silhouette, frame.depth.size(), 0.0, 0.0, cv::INTER_NEAREST);
     return silhouette & (frame.depth > 0.0f);
   }
 
-  cv::Mat mask(const RgbdFrame& frame, std::span<const ObservedSurface> object, const SE3d& T_cam_obj) const {
+  cv::Mat mask(const RgbdFrame& frame, const ObservedObject& object, const SE3d& T_cam_obj) const {
     requireStarted(frame);
     cv::Mat rendered;
-    cv::resize(renderDepth(object, T_cam_obj, gridSize(frame)), rendered, frame.depth.size(), 0.0, 0.0, cv::INTER_NEAREST);
+    cv::resize(renderDepth(object.surfaces(T_cam_obj), T_cam_obj, gridSize(frame)), rendered, frame.depth.size(), 0.0, 0.0, cv::INTER_NEAREST);
     cv::Mat region;
     const int g = settings_.growth_px;
     cv::dilate(rendered > 0.0f, region, cv::getStructuringElement(cv::MORPH_ELLIPSE, {2 * g + 1, 2 * g + 1}));
@@ -150,7 +149,7 @@ class PropagatedMasks {
 
   /// Depth of the observed surfaces under T_cam_obj on the grid (z-buffer, one grid cell per
   /// point), with one-cell holes between neighbouring points closed; 0 where nothing lands.
-  cv::Mat renderDepth(std::span<const ObservedSurface> object, const SE3d& T_cam_obj, cv::Size size) const {
+  cv::Mat renderDepth(const std::vector<ObservedSurface>& object, const SE3d& T_cam_obj, cv::Size size) const {
     const PinholeCameraf grid = downsampledCamera(camera_, grid_step_);
     cv::Mat depth(size, CV_32FC1, cv::Scalar(0.0f));
     for (const ObservedSurface& surface : object) {
@@ -160,10 +159,8 @@ class PropagatedMasks {
           const cv::Vec3f& p = surface.points.at<cv::Vec3f>(y, x);
           if (p[2] <= 0.0f) continue;
           const Eigen::Vector3f q = T.leftCols<3>() * Eigen::Vector3f(p[0], p[1], p[2]) + T.col(3);
-          if (q.z() <= 0.0f) continue;
-          const int u = int(std::lround(grid.fx * q.x() / q.z() + grid.cx));
-          const int v = int(std::lround(grid.fy * q.y() / q.z() + grid.cy));
-          if (u < 0 || v < 0 || u >= size.width || v >= size.height) continue;
+          int u = 0, v = 0;
+          if (!grid.pixelOf(q, u, v) || u < 0 || v < 0 || u >= size.width || v >= size.height) continue;
           float& d = depth.at<float>(v, u);
           if (d == 0.0f || q.z() < d) d = q.z();
         }

@@ -2,15 +2,14 @@
 
 #include <algorithm>
 #include <cmath>
-#include <concepts>
 #include <cstdint>
-#include <numbers>
 #include <utility>
 #include <vector>
 
-#include <opencv2/core.hpp>
-
+#include "bundletrack/core/angles.hpp"
+#include "bundletrack/core/execution.hpp"
 #include "bundletrack/features/frame_features.hpp"
+#include "bundletrack/registration/feature_registration.hpp"
 #include "bundletrack/registration/kabsch.hpp"
 #include "bundletrack/registration/ransac_trial.hpp"
 
@@ -22,8 +21,8 @@ struct RansacSettings {
   int max_trials = 2000;  ///< cap on hypotheses (the original code always ran 2000)
   double confidence = 0.999;  ///< stop once a better hypothesis is this unlikely to have been missed
   float min_sample_spread = 0.005f;  ///< metres; smallest height of a sample triangle (rejects near-collinear ones)
-  int batch = 64;  ///< hypotheses scored together (in parallel when `parallel`)
-  bool parallel = true;
+  int batch = 64;  ///< hypotheses scored together
+  Execution execution = Execution::Parallel;  ///< how the CPU scores a batch (the GPU scores it in one launch)
   std::uint64_t seed = 0;
 };
 
@@ -61,7 +60,7 @@ struct InlierGate {
 
   explicit InlierGate(const RansacSettings& s)
       : max_squared_distance(s.inlier_distance * s.inlier_distance),
-        cos_max_angle(std::cos(s.inlier_normal_angle_deg * std::numbers::pi_v<float> / 180.0f)) {}
+        cos_max_angle(cosOfDegrees<float>(s.inlier_normal_angle_deg)) {}
 
   bool admits(const MatchedPoints& pairs, std::size_t k, const SE3f& T, const Eigen::Matrix3f& R) const {
     return (T * pairs.first[k] - pairs.second[k]).squaredNorm() < max_squared_distance &&
@@ -92,12 +91,10 @@ concept TrialScorer = requires(T& scorer, const MatchedPoints& pairs, const Rans
   scorer.score(pairs, settings, gate, 0, 1, fits, valid, scores);
 };
 
-/// Trials on the CPU: samples and kabsch fits one by one, inliers counted per hypothesis (in
-/// parallel when asked).
+/// Trials on the CPU: samples and kabsch fits one by one, inliers counted per hypothesis
+/// (settings.execution: in parallel, or one by one).
 class CpuTrialScorer {
  public:
-  explicit CpuTrialScorer(bool parallel = true) : parallel_(parallel) {}
-
   void prepare(const MatchedPoints&) {}
 
   void score(const MatchedPoints& pairs, const RansacSettings& settings, const InlierGate& gate, int first, int count,
@@ -111,22 +108,14 @@ class CpuTrialScorer {
       fits[std::size_t(b)] = kabsch(3, [&](std::size_t k) { return pairs.pair(std::size_t(sample[k])); });
       hypotheses[std::size_t(b)] = fits[std::size_t(b)].cast<float>();
     }
-    const auto body = [&](const cv::Range& range) {
-      for (int h = range.start; h < range.end; ++h) {
-        scores[std::size_t(h)] = 0;
-        if (!valid[std::size_t(h)]) continue;
-        const SE3f& T = hypotheses[std::size_t(h)];
-        const Eigen::Matrix3f R = T.rotationMatrix();
-        for (std::size_t k = 0; k < pairs.size(); ++k) scores[std::size_t(h)] += gate.admits(pairs, k, T, R);
-      }
-    };
-    const cv::Range all(0, count);
-    if (parallel_) cv::parallel_for_(all, body);
-    else body(all);
+    forEachIndex(settings.execution, count, [&](int h) {
+      scores[std::size_t(h)] = 0;
+      if (!valid[std::size_t(h)]) return;
+      const SE3f& T = hypotheses[std::size_t(h)];
+      const Eigen::Matrix3f R = T.rotationMatrix();
+      for (std::size_t k = 0; k < pairs.size(); ++k) scores[std::size_t(h)] += gate.admits(pairs, k, T, R);
+    });
   }
-
- private:
-  bool parallel_;
 };
 
 /// RANSAC over 3-D feature matches (paper IV-B): 3-point samples, closed-form fit (kabsch), a match
@@ -197,19 +186,7 @@ class BasicRansac {
   mutable Scorer scorer_;  // a backend may keep device buffers between calls
 };
 
-/// RANSAC with the inliers counted on the CPU (in parallel unless settings.parallel is false).
-class Ransac : public BasicRansac<CpuTrialScorer> {
- public:
-  explicit Ransac(RansacSettings settings = {}) : BasicRansac(settings, CpuTrialScorer(settings.parallel)) {}
-};
-
-/// What the tracker asks of its robust registration (Ransac, cuda::Ransac): built from the
-/// RANSAC settings, it estimates the pose between two frames' features from their matches.
-template <typename T>
-concept FeatureRegistration =
-    std::constructible_from<T, RansacSettings> &&
-    requires(const T& registration, const FrameFeatures& features, const std::vector<FeatureMatch>& matches) {
-      { registration.estimate(features, features, matches) } -> std::same_as<RansacResult>;
-    };
+/// RANSAC with its trials on the CPU.
+using Ransac = BasicRansac<CpuTrialScorer>;
 
 }  // namespace bundletrack

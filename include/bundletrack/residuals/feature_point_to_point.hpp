@@ -1,6 +1,8 @@
 #pragma once
 
-#include "bundletrack/residuals/pair_system.hpp"
+#include <vector>
+
+#include "bundletrack/residuals/residual.hpp"
 
 namespace bundletrack {
 
@@ -8,14 +10,22 @@ namespace bundletrack {
 /// point, r = T_i^-1 p_m - T_j^-1 p_n (object frame, 3-D). With right perturbations,
 /// dr/dd_i = [-I, [T_i^-1 p_m]x] and dr/dd_j = -[-I, [T_j^-1 p_n]x].
 struct FeaturePointToPoint {
+  struct Input {
+    const FrameFeatures& i;
+    const FrameFeatures& j;
+    const std::vector<FeatureMatch>& matches;  ///< first = i, second = j
+  };
+  static Input input(const EdgeView& edge) { return {edge.i.features, edge.j.features, edge.matches}; }
+
   template <RobustLoss Loss>
-  void linearise(const PairInput& in, const Loss& loss, double weight, PairSystem& system) const {
+  void linearise(const Input& in, const SE3d& T_i, const SE3d& T_j, const Loss& loss, double weight,
+                 PairSystem& system) const {
     for (const FeatureMatch& match : in.matches) {
-      const Eigen::Vector3d p_m = in.i.features.points[match.first].cast<double>();
-      const Eigen::Vector3d p_n = in.j.features.points[match.second].cast<double>();
-      const Eigen::Vector3d r = in.T_i.inverse() * p_m - in.T_j.inverse() * p_n;
-      const Eigen::Matrix<double, 3, 6> J_i = in.T_i.J_inverseAction_delta(p_m);
-      const Eigen::Matrix<double, 3, 6> J_j = -in.T_j.J_inverseAction_delta(p_n);
+      const Eigen::Vector3d p_m = in.i.points[std::size_t(match.first)].cast<double>();
+      const Eigen::Vector3d p_n = in.j.points[std::size_t(match.second)].cast<double>();
+      const Eigen::Vector3d r = T_i.inverse() * p_m - T_j.inverse() * p_n;
+      const Eigen::Matrix<double, 3, 6> J_i = T_i.J_inverseAction_delta(p_m);
+      const Eigen::Matrix<double, 3, 6> J_j = -T_j.J_inverseAction_delta(p_n);
       system.add<3>(r, J_i, J_j, loss, weight);
     }
   }

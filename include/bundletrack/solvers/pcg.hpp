@@ -3,16 +3,13 @@
 #include <cmath>
 #include <vector>
 
-#include <Eigen/Cholesky>
-
+#include "bundletrack/solvers/block_jacobi.hpp"
 #include "bundletrack/solvers/linear_solver.hpp"
 
 namespace bundletrack {
 
-/// Preconditioned conjugate gradients (paper IV-D) with a block-Jacobi preconditioner: the
-/// inverse of each node's 6x6 diagonal block, damped by `damping` times its mean diagonal before
-/// the factorisation; a block that still fails to factor falls back to its inverted diagonal.
-/// Stops after max_iterations or when |H x - rhs| <= tolerance |rhs|.
+/// Preconditioned conjugate gradients (paper IV-D) with the block-Jacobi preconditioner of
+/// blockJacobiInverse. Stops after max_iterations or when |H x - rhs| <= tolerance |rhs|.
 struct PCG {
   int max_iterations = 5;  ///< the original code's 5 inner iterations per Gauss-Newton step
   double tolerance = 1e-10;
@@ -21,18 +18,9 @@ struct PCG {
   SolveReport solve(const Eigen::MatrixXd& H, const Eigen::VectorXd& rhs, Eigen::VectorXd& x) const {
     const Eigen::Index n = H.rows(), blocks = n / 6;
     std::vector<Eigen::Matrix<double, 6, 6>> inverse(static_cast<std::size_t>(blocks));
-    for (Eigen::Index k = 0; k < blocks; ++k) {
-      Eigen::Matrix<double, 6, 6> block = H.block<6, 6>(6 * k, 6 * k);
-      const double mean_diagonal = block.diagonal().mean();
-      block.diagonal().array() += damping * (mean_diagonal > 0.0 ? mean_diagonal : 1.0);
-      const Eigen::LLT<Eigen::Matrix<double, 6, 6>> llt(block);
-      if (llt.info() == Eigen::Success) {
-        inverse[std::size_t(k)] = llt.solve(Eigen::Matrix<double, 6, 6>::Identity());
-      } else {
-        const Eigen::Matrix<double, 6, 1> d = block.diagonal().cwiseMax(1e-12);
-        inverse[std::size_t(k)] = d.cwiseInverse().asDiagonal();
-      }
-    }
+    blockJacobiInverse(H, damping, [&](Eigen::Index k, const Eigen::Matrix<double, 6, 6>& block_inverse) {
+      inverse[std::size_t(k)] = block_inverse;
+    });
     const auto precondition = [&](const Eigen::VectorXd& r) {
       Eigen::VectorXd z(n);
       for (Eigen::Index k = 0; k < blocks; ++k) z.segment<6>(6 * k) = inverse[std::size_t(k)] * r.segment<6>(6 * k);

@@ -10,7 +10,7 @@
 
 #include "bundletrack/core/camera.hpp"
 #include "bundletrack/core/se3.hpp"
-#include "bundletrack/eval/box_iou.hpp"
+#include "bundletrack/core/object_box.hpp"
 
 namespace bundletrack::viz {
 

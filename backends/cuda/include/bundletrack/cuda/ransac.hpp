@@ -27,9 +27,6 @@ class TrialScorer {
 /// bundletrack::Ransac with its trials drawn, fitted and scored on the GPU: the same samples,
 /// adaptive stop and refit, so it returns the CPU's result up to float rounding at the inlier
 /// boundary. Satisfies FeatureRegistration.
-class Ransac : public BasicRansac<TrialScorer> {
- public:
-  explicit Ransac(RansacSettings settings = {}) : BasicRansac(settings) {}
-};
+using Ransac = BasicRansac<TrialScorer>;
 
 }  // namespace bundletrack::cuda

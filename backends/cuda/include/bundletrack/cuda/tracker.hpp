@@ -4,7 +4,7 @@
 #include "bundletrack/cuda/matching.hpp"
 #include "bundletrack/cuda/pcg.hpp"
 #include "bundletrack/cuda/ransac.hpp"
-#include "bundletrack/tracker.hpp"
+#include "bundletrack/default_tracker.hpp"
 
 namespace bundletrack::cuda {
 
@@ -13,8 +13,8 @@ namespace bundletrack::cuda {
 using DefaultEnergy = Energy<Term<FeaturePointToPoint, HuberLoss>, Term<DensePointToPlane, HuberLoss>>;
 
 /// The tracker with every GPU policy of this backend: dense term, PCG, descriptor matching and
-/// RANSAC on the device; the Detector finds keypoints on the CPU.
+/// RANSAC on the device; the Detector finds keypoints on the CPU, the verification runs there.
 template <CorrespondenceSource Detector = SiftFeatures, MaskSource Masks = GivenMasks>
-using Tracker = bundletrack::Tracker<DefaultEnergy, PCG, GpuMatched<Detector>, Masks, Ransac>;
+using Tracker = bundletrack::Tracker<DefaultEnergy, PCG, GpuMatched<Detector>, Masks, Ransac, SurfaceAgreement>;
 
 }  // namespace bundletrack::cuda

@@ -1,28 +1,10 @@
 #pragma once
 
-#include <concepts>
-#include <span>
-#include <vector>
-
 #include <Eigen/Core>
 
-#include "bundletrack/core/camera.hpp"
-#include "bundletrack/features/frame_features.hpp"
-#include "bundletrack/graph/keyframe.hpp"
 #include "bundletrack/robust/losses.hpp"
 
 namespace bundletrack {
-
-/// Everything a residual sees of one edge (i, j) of the pose graph: both nodes with their current
-/// poses, the edge's feature correspondences (first = i, second = j) and the dense grid's camera.
-struct PairInput {
-  const Keyframe& i;
-  const Keyframe& j;
-  const SE3d& T_i;
-  const SE3d& T_j;
-  const std::vector<FeatureMatch>& matches;
-  const PinholeCameraf& grid_camera;
-};
 
 /// The weighted normal equations of one edge over the stacked right perturbations [d_i; d_j]:
 /// H += J^T W J, b += J^T W r, cost += rho, summed over the edge's residuals.
@@ -85,20 +67,6 @@ struct PairSystem {
  private:
   Eigen::Matrix<double, 6, 6> relative_H_ = Eigen::Matrix<double, 6, 6>::Zero();
   Eigen::Matrix<double, 6, 1> relative_b_ = Eigen::Matrix<double, 6, 1>::Zero();
-};
-
-/// An energy term of the pose graph (paper eq. 2, 3): adds its residuals of one edge to a PairSystem.
-template <typename T>
-concept Residual = requires(const T& residual, const PairInput& input, const HuberLoss& loss, PairSystem& system) {
-  { residual.linearise(input, loss, 1.0, system) } -> std::same_as<void>;
-};
-
-/// A residual that also linearises many edges in one call, systems[e] receiving what
-/// linearise(inputs[e], ...) would add (a GPU backend: one launch for every edge of the graph).
-template <typename T>
-concept BatchResidual = Residual<T> && requires(const T& residual, std::span<const PairInput> inputs, const HuberLoss& loss,
-                                                std::span<PairSystem> systems) {
-  { residual.lineariseAll(inputs, loss, 1.0, systems) } -> std::same_as<void>;
 };
 
 }  // namespace bundletrack

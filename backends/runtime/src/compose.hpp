@@ -1,0 +1,59 @@
+#pragma once
+
+// What every tracker of makeTracker is built from: the policies of a Config.
+
+#include <memory>
+#include <utility>
+
+#include "bundletrack/config/config.hpp"
+#include "bundletrack/default_tracker.hpp"
+#include "bundletrack/tracking/any_tracker.hpp"
+
+namespace bundletrack::runtime {
+
+/// The detector `config.features` names with the settings every detector shares. SiftFeatures,
+/// OrbFeatures and AkazeFeatures differ only in how they build their cv::Feature2D, so one
+/// OpenCvFeatureSource type serves the run-time choice.
+inline OpenCvFeatureSource featureSource(const Config& config) {
+  if (config.features == "orb") {
+    OrbSettings orb = config.orb;
+    orb.max_keypoints = config.sift.max_keypoints, orb.crop = config.sift.crop, orb.matching = config.sift.matching;
+    return OrbFeatures(orb);
+  }
+  if (config.features == "akaze") {
+    AkazeSettings akaze = config.akaze;
+    akaze.max_keypoints = config.sift.max_keypoints, akaze.crop = config.sift.crop, akaze.matching = config.sift.matching;
+    return AkazeFeatures(akaze);
+  }
+  return SiftFeatures(config.sift);
+}
+
+inline RansacSettings ransacSettings(const Config& config) {
+  RansacSettings settings = config.ransac;
+  settings.execution = config.execution;
+  return settings;
+}
+
+/// The default energy (paper eq. 1) with a dense term of type Dense.
+template <typename Dense>
+Energy<Term<FeaturePointToPoint, HuberLoss>, Term<Dense, HuberLoss>> energy(const Config& config, Dense dense) {
+  Energy<Term<FeaturePointToPoint, HuberLoss>, Term<Dense, HuberLoss>> e{
+      {Term<FeaturePointToPoint, HuberLoss>{{}, config.feature_loss, 1.0}, Term<Dense, HuberLoss>{std::move(dense), config.dense_loss, 1.0}},
+      config.execution};
+  return e;
+}
+
+/// The full CPU tracker with the given mask source.
+template <typename Masks>
+std::unique_ptr<AnyTracker> cpuTracker(const Config& config, const PinholeCameraf& camera, Masks masks) {
+  using CpuTracker = Tracker<DefaultEnergy, PCG, OpenCvFeatureSource, Masks, Ransac, SurfaceAgreement>;
+  return eraseTracker(CpuTracker(camera, config.tracking, energy(config, config.dense), config.pcg, featureSource(config),
+                                 std::move(masks), Ransac(ransacSettings(config)), SurfaceAgreement(config.verification)));
+}
+
+// One translation unit each, so that the heavy instantiations compile in parallel.
+std::unique_ptr<AnyTracker> cpuTrackerWithGivenMasks(const Config& config, const PinholeCameraf& camera);
+std::unique_ptr<AnyTracker> cpuTrackerWithPropagatedMasks(const Config& config, const PinholeCameraf& camera);
+std::unique_ptr<AnyTracker> gpuTracker(const Config& config, const PinholeCameraf& camera);
+
+}  // namespace bundletrack::runtime

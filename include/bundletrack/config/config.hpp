@@ -1,0 +1,165 @@
+#pragma once
+
+#include <cstddef>
+#include <functional>
+#include <limits>
+#include <string>
+#include <utility>
+#include <variant>
+#include <vector>
+
+#include "bundletrack/core/execution.hpp"
+#include "bundletrack/features/opencv_features.hpp"
+#include "bundletrack/io/ycbineoat_sequence.hpp"
+#include "bundletrack/masks/propagated_masks.hpp"
+#include "bundletrack/registration/ransac.hpp"
+#include "bundletrack/residuals/dense_point_to_plane.hpp"
+#include "bundletrack/robust/losses.hpp"
+#include "bundletrack/solvers/pcg.hpp"
+#include "bundletrack/tracking/tracker_settings.hpp"
+#include "bundletrack/verification/surface_agreement.hpp"
+
+namespace bundletrack {
+
+/// Every run-time choice and setting of a tracker built by makeTracker (bundletrack::runtime) and
+/// of the example programs. The defaults are those of the structs each field is: the policies'
+/// own settings, so each default lives in one place.
+struct Config {
+  std::string tracker = "full";  ///< full: pose graph (paper IV) | coarse: frame-to-frame RANSAC
+  io::SequenceSettings sequence;
+  std::string features = "sift";  ///< sift | orb | akaze
+  SiftSettings sift;  ///< with the settings every detector shares (max_keypoints, crop, matching)
+  OrbSettings orb;
+  AkazeSettings akaze;
+  RansacSettings ransac;
+  TrackerSettings tracking;
+  SurfaceAgreementSettings verification;
+  HuberLoss feature_loss;
+  HuberLoss dense_loss;
+  DensePointToPlane dense;
+  PCG pcg;
+  std::string masks = "given";  ///< given | propagated
+  PropagatedMaskSettings propagated_masks;
+  std::string device = "cpu";  ///< cpu | gpu
+  Execution execution = Execution::Parallel;
+};
+
+/// A setting chosen by name among `names`, read and written as text.
+struct ConfigChoice {
+  std::vector<std::string> names;
+  std::function<std::string()> get;
+  std::function<void(const std::string&)> set;
+};
+
+/// One setting: section.key, where it lives (a number of some type, or a choice), its valid range
+/// (numbers), unit and meaning. The table of them (configEntries) is what the YAML reader, the
+/// printer and the README's reference table are made from.
+struct ConfigEntry {
+  const char* section;
+  const char* key;
+  std::variant<int*, float*, double*, std::size_t*, ConfigChoice> value;
+  double min, max;
+  const char* unit;
+  const char* meaning;
+
+  std::string name() const { return std::string(section) + "." + key; }
+};
+
+namespace detail {
+
+inline ConfigChoice textChoice(std::string& value, std::vector<std::string> names) {
+  return {std::move(names), [&value] { return value; }, [&value](const std::string& name) { value = name; }};
+}
+
+template <typename Enum>
+ConfigChoice enumChoice(Enum& value, std::vector<std::pair<std::string, Enum>> options) {
+  std::vector<std::string> names;
+  for (const auto& option : options) names.push_back(option.first);
+  return {std::move(names),
+          [&value, options] {
+            for (const auto& [name, option] : options)
+              if (option == value) return name;
+            return std::string("?");
+          },
+          [&value, options](const std::string& name) {
+            for (const auto& [option_name, option] : options)
+              if (option_name == name) value = option;
+          }};
+}
+
+}  // namespace detail
+
+/// The table of every setting of `c`, in the order they are printed and documented.
+inline std::vector<ConfigEntry> configEntries(Config& c) {
+  constexpr double inf = std::numeric_limits<double>::infinity();
+  auto& depth = c.sequence.frame.depth_filter;
+  auto& t = c.tracking;
+  auto& m = c.propagated_masks;
+  using detail::enumChoice, detail::textChoice;
+  return {
+      {"tracker", "type", textChoice(c.tracker, {"full", "coarse"}), 0, 0, "",
+       "full: pose graph over keyframes (paper IV); coarse: frame-to-frame RANSAC only"},
+      {"depth", "scale", &c.sequence.depth_scale, 1e-6, 1.0, "m/unit", "metres per unit of the 16-bit depth images"},
+      {"depth", "min_depth", &depth.min_depth, 0.0, 100.0, "m", "closer readings are invalid"},
+      {"depth", "max_depth", &depth.max_depth, 0.0, inf, "m", "farther readings are invalid"},
+      {"depth", "erode_radius", &depth.erode_radius, 0, 10, "px", "erosion neighbourhood radius (1: 3x3)"},
+      {"depth", "erode_depth_diff", &depth.erode_depth_diff, 0.0, 1.0, "m", "a neighbour this far in depth counts against a pixel"},
+      {"depth", "erode_ratio", &depth.erode_ratio, 0.0, 1.0, "", "fraction of neighbours against a pixel that removes it"},
+      {"depth", "smooth_radius", &depth.smooth_radius, 0, 10, "px", "smoothing window radius (2: 5x5)"},
+      {"depth", "smooth_sigma", &depth.smooth_sigma, 1e-3, 100.0, "px", "spatial Gaussian of the smoothing"},
+      {"depth", "smooth_depth_window", &depth.smooth_depth_window, 0.0, 1.0, "m", "neighbours within this depth of a pixel are averaged"},
+      {"depth", "smooth_passes", &depth.smooth_passes, 0, 10, "", "smoothing passes"},
+      {"depth", "normal_max_depth_jump", &c.sequence.frame.normal_max_depth_jump, 0.0, 1.0, "m", "no normal across a larger depth jump"},
+      {"features", "type", textChoice(c.features, {"sift", "orb", "akaze"}), 0, 0, "", "keypoint detector and descriptor"},
+      {"features", "max_keypoints", &c.sift.max_keypoints, 3, 100000, "", "strongest keypoints kept per frame"},
+      {"features", "sift_contrast_threshold", &c.sift.contrast_threshold, 0.0, 1.0, "", "SIFT contrast threshold (original config: 0.01)"},
+      {"features", "crop_size", &c.sift.crop.crop_size, 32, 4096, "px", "side of the square object crop the detector runs on"},
+      {"features", "mask_dilation", &c.sift.crop.mask_dilation, 0, 100, "px", "the detector sees this much around the mask"},
+      {"features", "ratio", &c.sift.matching.ratio, 0.0, 1.0, "", "Lowe's ratio test, both directions"},
+      {"ransac", "inlier_distance", &c.ransac.inlier_distance, 1e-5, 1.0, "m", "paper IV-B delta"},
+      {"ransac", "inlier_normal_angle_deg", &c.ransac.inlier_normal_angle_deg, 0.0, 180.0, "deg", "paper IV-B alpha"},
+      {"ransac", "max_trials", &c.ransac.max_trials, 1, 1000000, "", "cap on hypotheses"},
+      {"ransac", "confidence", &c.ransac.confidence, 0.0, 0.999999999, "", "adaptive stop: chance of having missed a better hypothesis"},
+      {"ransac", "min_inliers", &t.min_inliers, 3, 100000, "", "fewest inliers with the previous frame for a coarse pose"},
+      {"graph", "max_keyframes", &t.max_keyframes, 1, 1000, "", "K: keyframes in the pose graph (paper IV-C)"},
+      {"graph", "pool_capacity", &t.pool_capacity, 2, 100000, "", "keyframes kept in memory"},
+      {"graph", "new_keyframe_rotation_deg", &t.new_keyframe_rotation_deg, 0.0, 180.0, "deg", "paper IV-E"},
+      {"graph", "dense_grid_step", &t.dense_grid_step, 1, 64, "px", "the surface grids (dense term, verification, masks) sample every this many pixels"},
+      {"graph", "edge_gate_distance", &t.edge_gate.max_distance, 0.0, 1.0, "m", "feature matches of an edge must agree with the poses"},
+      {"graph", "edge_gate_normal_angle_deg", &t.edge_gate.max_normal_angle_deg, 0.0, 180.0, "deg", "same, for normals"},
+      {"graph", "min_edge_correspondences", &t.min_edge_correspondences, 3, 100000, "", "fewer: the edge has no feature term"},
+      {"graph", "min_agreement", &c.verification.min_agreement, 0.0, 1.0, "", "fraction of overlapping points on a keyframe's surface to accept the graph's pose"},
+      {"graph", "agreement_distance", &c.verification.gate.max_distance, 0.0, 1.0, "m", "on the surface: within this distance"},
+      {"graph", "agreement_normal_angle_deg", &c.verification.gate.max_normal_angle_deg, 0.0, 180.0, "deg", "on the surface: normals within this angle"},
+      {"graph", "recovery_min_inliers", &t.recovery_min_inliers, 3, 100000, "", "RANSAC inliers needed to restart after lost frames"},
+      {"graph", "recovery_min_keypoints", &t.recovery_min_keypoints, 0, 100000, "", "fewer keypoints: a lost frame is re-acquired by the surface alone"},
+      {"graph", "recovery_min_agreement", &c.verification.recovery_min_agreement, 0.0, 1.0, "", "agreement such a re-acquisition needs"},
+      {"graph", "gauss_newton_iterations", &t.gauss_newton.iterations, 0, 1000, "", "paper IV-D, original code: 7"},
+      {"energy", "feature_huber_delta", &c.feature_loss.delta, 1e-6, 1.0, "m", "Huber delta of the feature term (paper eq. 2)"},
+      {"energy", "dense_huber_delta", &c.dense_loss.delta, 1e-6, 1.0, "m", "Huber delta of the dense term (paper eq. 3)"},
+      {"energy", "dense_max_distance", &c.dense.gate.max_distance, 0.0, 1.0, "m", "dense association: points farther apart are not paired"},
+      {"energy", "dense_max_normal_angle_deg", &c.dense.gate.max_normal_angle_deg, 0.0, 180.0, "deg", "dense association: nor normals farther apart"},
+      {"solver", "step_control", enumChoice(t.gauss_newton.step_control, {{"none", StepControl::None}, {"levenberg_marquardt", StepControl::LevenbergMarquardt}}), 0, 0, "",
+       "none: every Gauss-Newton step is taken (paper); levenberg_marquardt: damped, a step that raises the energy is rejected"},
+      {"solver", "min_translation_step", &t.gauss_newton.min_translation_step, 0.0, 1.0, "m", "Gauss-Newton stops when no node moves more ..."},
+      {"solver", "min_rotation_step", &t.gauss_newton.min_rotation_step, 0.0, 1.0, "rad", "... and none turns more"},
+      {"solver", "pcg_max_iterations", &c.pcg.max_iterations, 1, 100000, "", "PCG iterations per step (original code: 5)"},
+      {"solver", "pcg_tolerance", &c.pcg.tolerance, 0.0, 1.0, "", "PCG stops at this relative residual (the GPU's float PCG at 1e-6 at the least)"},
+      {"masks", "source", textChoice(c.masks, {"given", "propagated"}), 0, 0, "",
+       "given: every frame's mask from the data; propagated: from the first mask alone"},
+      {"masks", "search_margin_px", &m.search_margin_px, 0, 10000, "px", "propagated: keypoints are searched this far around the last pose's silhouette"},
+      {"masks", "growth_px", &m.growth_px, 0, 10000, "px", "propagated: the mask reaches this far beyond the rendered silhouette"},
+      {"masks", "depth_agreement", &m.depth_agreement, 0.0, 1.0, "m", "propagated: observed vs rendered depth that seeds the mask"},
+      {"masks", "depth_continuity", &m.depth_continuity, 0.0, 1.0, "m", "propagated: largest depth step between neighbouring mask pixels (up to 1 m; times z^2 beyond)"},
+      {"masks", "hull_dilation_px", &m.hull_dilation_px, 0, 1000, "px", "propagated: slack of the first view's silhouette"},
+      {"masks", "hull_depth_tolerance", &m.hull_depth_tolerance, 0.0, 1.0, "m", "propagated: slack in front of the first view's surface"},
+      {"masks", "object_size_factor", &m.object_size_factor, 0.0, 100.0, "", "propagated, after lost: searched surfaces are at most this times the first view's extent"},
+      {"masks", "min_area_fraction", &m.min_area_fraction, 0.0, 1.0, "", "propagated, after lost: and show this fraction of the first view's area"},
+      {"compute", "device", textChoice(c.device, {"cpu", "gpu"}), 0, 0, "",
+       "cpu: header-only policies; gpu: matching, dense term, PCG and RANSAC on a CUDA device (bundletrack::cuda; keypoints are still detected on the CPU)"},
+      {"compute", "execution", enumChoice(c.execution, {{"parallel", Execution::Parallel}, {"serial", Execution::Serial}}), 0, 0, "",
+       "parallel: edges and RANSAC trials on all cores; serial: one thread (the same poses either way)"},
+  };
+}
+
+}  // namespace bundletrack

@@ -1,0 +1,33 @@
+#pragma once
+
+// Pinhole projection to a pixel, in plain arithmetic for the host and CUDA kernels alike
+// (pixel centres at integer coordinates, docs/DESIGN.md section 2).
+
+#include <cmath>
+
+#include "bundletrack/core/macros.hpp"
+
+namespace bundletrack {
+
+/// The pixel a continuous image coordinate falls in: rounded half away from zero.
+template <typename T>
+BUNDLETRACK_HOST_DEVICE int roundToPixel(T x) {
+#ifdef __CUDA_ARCH__
+  return int(::lround(x));
+#else
+  return int(std::lround(x));
+#endif
+}
+
+/// The pixel (u, v) that camera-frame point (x, y, z) projects into, u = fx x / z + cx and
+/// v = fy y / z + cy computed in T; false (u, v untouched) for a point on or behind the image
+/// plane. Bounds are the caller's to check.
+template <typename C, typename T>
+BUNDLETRACK_HOST_DEVICE bool projectToPixel(C fx, C fy, C cx, C cy, T x, T y, T z, int& u, int& v) {
+  if (!(z > T(0))) return false;
+  u = roundToPixel(T(fx) * x / z + T(cx));
+  v = roundToPixel(T(fy) * y / z + T(cy));
+  return true;
+}
+
+}  // namespace bundletrack

@@ -1,0 +1,60 @@
+#pragma once
+
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+#include "bundletrack/core/camera.hpp"
+#include "bundletrack/core/rgbd_frame.hpp"
+
+namespace bundletrack {
+
+/// The camera of an image downsampled by `step` (grid pixel (x, y) is full-resolution pixel
+/// (step x, step y)): fx' = fx / step, cx' = cx / step.
+inline PinholeCameraf downsampledCamera(const PinholeCameraf& camera, int step) {
+  const float s = 1.0f / float(step);
+  return {camera.fx * s, camera.fy * s, camera.cx * s, camera.cy * s};
+}
+
+/// A frame's object surface on a downsampled grid, as the dense term (paper eq. 3), the pose
+/// verification and the mask renderer read it: camera-frame points and unit normals, zero where
+/// the frame has none (outside the mask, no depth, no normal); the cells that hold a point; and
+/// the grid's own camera, so whoever projects into the grid needs nothing else.
+struct SurfaceGrid {
+  cv::Mat points;  ///< CV_32FC3
+  cv::Mat normals;  ///< CV_32FC3
+  std::vector<cv::Point> cells;  ///< grid cells with a point, row by row
+  PinholeCameraf camera{};
+
+  bool inside(int u, int v) const { return u >= 0 && v >= 0 && u < points.cols && v < points.rows; }
+};
+
+/// Samples the masked surface of `frame` every `step` pixels.
+inline SurfaceGrid sampleSurface(const RgbdFrame& frame, const cv::Mat& mask, const PinholeCameraf& camera, int step) {
+  SurfaceGrid grid;
+  grid.camera = downsampledCamera(camera, step);
+  const cv::Size size((frame.points.cols + step - 1) / step, (frame.points.rows + step - 1) / step);
+  grid.points.create(size, CV_32FC3);
+  grid.normals.create(size, CV_32FC3);
+  for (int y = 0; y < size.height; ++y) {
+    for (int x = 0; x < size.width; ++x) {
+      const int u = step * x, v = step * y;
+      const cv::Vec3f& n = frame.normals.at<cv::Vec3f>(v, u);
+      const bool use = mask.at<uchar>(v, u) && frame.points.at<cv::Vec3f>(v, u)[2] > 0.0f && n[2] != 0.0f;
+      grid.points.at<cv::Vec3f>(y, x) = use ? frame.points.at<cv::Vec3f>(v, u) : cv::Vec3f(0, 0, 0);
+      grid.normals.at<cv::Vec3f>(y, x) = use ? n : cv::Vec3f(0, 0, 0);
+      if (use) grid.cells.emplace_back(x, y);
+    }
+  }
+  return grid;
+}
+
+/// Lists the cells of a grid filled by hand (tests, synthetic data).
+inline void indexCells(SurfaceGrid& grid) {
+  grid.cells.clear();
+  for (int y = 0; y < grid.points.rows; ++y)
+    for (int x = 0; x < grid.points.cols; ++x)
+      if (grid.points.at<cv::Vec3f>(y, x)[2] > 0.0f) grid.cells.emplace_back(x, y);
+}
+
+}  // namespace bundletrack

@@ -1,0 +1,51 @@
+#pragma once
+
+#include <cstddef>
+#include <memory>
+#include <utility>
+
+#include "bundletrack/core/rgbd_frame.hpp"
+#include "bundletrack/tracking/track_result.hpp"
+
+namespace bundletrack {
+
+/// Any tracker behind one small interface, for code that chooses its tracker at run time (the
+/// command-line tracker, the benchmarks, bindings). Feed frames in order: initialize() with the
+/// first, then track() each one.
+class AnyTracker {
+ public:
+  virtual ~AnyTracker() = default;
+  virtual TrackResult initialize(const RgbdFrame& frame, const SE3d& T_cam_obj) = 0;
+  virtual TrackResult track(const RgbdFrame& frame) = 0;
+  /// Keyframes in memory (0 for a tracker without a pool).
+  virtual std::size_t keyframeCount() const = 0;
+};
+
+namespace detail {
+
+template <typename TrackerT>
+class ErasedTracker final : public AnyTracker {
+ public:
+  explicit ErasedTracker(TrackerT tracker) : tracker_(std::move(tracker)) {}
+  TrackResult initialize(const RgbdFrame& frame, const SE3d& T_cam_obj) override {
+    return tracker_.initialize(frame, T_cam_obj);
+  }
+  TrackResult track(const RgbdFrame& frame) override { return tracker_.track(frame); }
+  std::size_t keyframeCount() const override {
+    if constexpr (requires { tracker_.keyframes().size(); }) return tracker_.keyframes().size();
+    else return 0;
+  }
+
+ private:
+  TrackerT tracker_;
+};
+
+}  // namespace detail
+
+/// Wraps a tracker composed at compile time (Tracker<...>, CoarseTracker<...>, your own).
+template <typename TrackerT>
+std::unique_ptr<AnyTracker> eraseTracker(TrackerT tracker) {
+  return std::make_unique<detail::ErasedTracker<TrackerT>>(std::move(tracker));
+}
+
+}  // namespace bundletrack
