@@ -20,6 +20,18 @@ static_assert(bt::BatchResidual<bt::cuda::DensePointToPlane>, "the GPU dense ter
 
 namespace {
 
+/// GPU and CPU normal equations (an edge's or a graph's) agree: the same residuals up to
+/// projections that round the other way at a pixel or gate boundary, and sums to float precision.
+template <typename System>
+void checkSame(const System& on_gpu, const System& on_cpu, int at_least) {
+  REQUIRE(on_cpu.residuals > at_least);
+  CHECK(std::abs(on_gpu.residuals - on_cpu.residuals) <= on_cpu.residuals / 1000 + 1);
+  const double tolerance = on_gpu.residuals == on_cpu.residuals ? 1e-4 : 1e-2;
+  CHECK((on_gpu.H - on_cpu.H).norm() <= tolerance * on_cpu.H.norm());
+  CHECK((on_gpu.b - on_cpu.b).norm() <= tolerance * on_cpu.b.norm());
+  CHECK(on_gpu.cost == doctest::Approx(on_cpu.cost).epsilon(tolerance));
+}
+
 template <typename Loss>
 void compare(const bt::Keyframe& a, const bt::Keyframe& b, const bt::SE3d& T_a, const bt::SE3d& T_b, const Loss& loss,
              const bt::cuda::DensePointToPlane& gpu) {
@@ -27,13 +39,7 @@ void compare(const bt::Keyframe& a, const bt::Keyframe& b, const bt::SE3d& T_a, 
   bt::PairSystem on_cpu, on_gpu;
   bt::DensePointToPlane{}.linearise(input, T_a, T_b, loss, 0.7, on_cpu);
   gpu.linearise(input, T_a, T_b, loss, 0.7, on_gpu);
-  REQUIRE(on_cpu.residuals > 500);
-  // The same residuals up to projections that round the other way at a pixel or gate boundary.
-  CHECK(std::abs(on_gpu.residuals - on_cpu.residuals) <= on_cpu.residuals / 1000 + 1);
-  const double tolerance = on_gpu.residuals == on_cpu.residuals ? 1e-4 : 1e-2;
-  CHECK((on_gpu.H - on_cpu.H).norm() <= tolerance * on_cpu.H.norm());
-  CHECK((on_gpu.b - on_cpu.b).norm() <= tolerance * on_cpu.b.norm());
-  CHECK(on_gpu.cost == doctest::Approx(on_cpu.cost).epsilon(tolerance));
+  checkSame(on_gpu, on_cpu, 500);
 }
 
 /// Keyframes (dense grid every 4 px) of the given frames of the default synthetic sequence and
@@ -104,11 +110,6 @@ TEST_CASE("GPU dense term assembles a whole graph in one launch as the CPU term 
   const bt::Energy<bt::Term<bt::cuda::DensePointToPlane, bt::HuberLoss>> gpu;
   for (int repeat = 0; repeat < 2; ++repeat) {  // the second time with the grids already on the device
     bt::assembleNormalEquations(gpu.over(graph), graph.poses, on_gpu);
-    REQUIRE(cpu.residuals > 3000);
-    CHECK(std::abs(on_gpu.residuals - cpu.residuals) <= cpu.residuals / 1000 + 1);
-    const double tolerance = on_gpu.residuals == cpu.residuals ? 1e-4 : 1e-2;
-    CHECK((on_gpu.H - cpu.H).norm() <= tolerance * cpu.H.norm());
-    CHECK((on_gpu.b - cpu.b).norm() <= tolerance * cpu.b.norm());
-    CHECK(on_gpu.cost == doctest::Approx(cpu.cost).epsilon(tolerance));
+    checkSame(on_gpu, cpu, 3000);
   }
 }

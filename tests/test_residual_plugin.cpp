@@ -7,6 +7,7 @@
 #include "bundletrack/default_tracker.hpp"
 #include "bundletrack/eval/sequence_score.hpp"
 #include "bundletrack/synth/synthetic_sequence.hpp"
+#include "cost_gradient.hpp"
 #include "feature_point_to_plane.hpp"
 
 namespace bt = bundletrack;
@@ -41,17 +42,8 @@ TEST_CASE("a test-only feature point-to-plane term: its normal equations are the
   const bt::SE3d B = T_j * bt::SE3d::exp((bt::SE3d::Tangent() << -0.001, 0.002, 0.003, -0.01, 0.02, 0.01).finished());
   const bt::PairSystem at = system(A, B);
   REQUIRE(at.residuals == 40);
-  // With the trivial loss b = J^T r, the gradient of 1/2 sum r^2 (cost = sum r^2).
-  Eigen::Matrix<double, 12, 1> gradient;
-  const double h = 1e-7;
-  for (int k = 0; k < 12; ++k) {
-    bt::SE3d::Tangent d = bt::SE3d::Tangent::Zero();
-    d[k % 6] = h;
-    const bool first = k < 6;
-    const double plus = system(first ? A * bt::SE3d::exp(d) : A, first ? B : B * bt::SE3d::exp(d)).cost;
-    const double minus = system(first ? A * bt::SE3d::exp(-d) : A, first ? B : B * bt::SE3d::exp(-d)).cost;
-    gradient[k] = (plus - minus) / (2 * h) / 2.0;
-  }
+  const Eigen::Matrix<double, 12, 1> gradient =
+      halfCostGradient([&](const bt::SE3d& T_a, const bt::SE3d& T_b) { return system(T_a, T_b).cost; }, A, B, 1e-7);
   CAPTURE(gradient.transpose());
   CAPTURE(at.b.transpose());
   CHECK((gradient - at.b).norm() <= 1e-6 * at.b.norm());
@@ -61,8 +53,8 @@ TEST_CASE("a tracker with the test-only term in its energy tracks the synthetic 
   synth::SyntheticSequenceSettings settings;
   settings.frames = 30;
   settings.speed = 2.0;
-  const synth::SyntheticScene scene(settings);
   const auto camera = settings.camera.cast<float>();
+  const synth::SyntheticScene scene(settings);
   using WithPlugin = bt::Energy<bt::Term<bt::FeaturePointToPoint, bt::HuberLoss>,
                                 bt::Term<bt::testing::FeaturePointToPlane, bt::HuberLoss>,
                                 bt::Term<bt::DensePointToPlane, bt::HuberLoss>>;

@@ -8,7 +8,7 @@
 
 namespace bundletrack {
 
-/// Depth clean-up before anything uses the depth (DESIGN.md section 3, after the original code).
+/// Depth clean-up before anything uses the depth (docs/DESIGN.md section 3, after the original code).
 struct DepthFilterSettings {
   float min_depth = 0.1f;  ///< metres; closer readings are invalid (below any RGB-D sensor's range)
   float max_depth = std::numeric_limits<float>::infinity();  ///< metres; farther readings are invalid

@@ -4,7 +4,7 @@
 
 namespace bundletrack {
 
-/// Rigid transforms T = (R, t), p' = R p + t. Conventions (DESIGN.md section 2): T_a_b maps frame b
+/// Rigid transforms T = (R, t), p' = R p + t. Conventions (docs/DESIGN.md section 2): T_a_b maps frame b
 /// into frame a; tangent vectors are ordered [v; w] (translation, then rotation); updates are right
 /// perturbations T <- T * exp(d). Jacobians are named after what they differentiate.
 template <typename Scalar_>

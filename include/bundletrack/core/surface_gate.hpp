@@ -6,7 +6,7 @@ namespace bundletrack {
 
 /// When two oriented points count as the same surface point: within max_distance of each other
 /// and with normals within max_normal_angle_deg. The defaults are the original code's gate for
-/// pairs of frames whose relative pose is known (DESIGN.md section 3: 2 cm, 45 degrees), used by
+/// pairs of frames whose relative pose is known (docs/DESIGN.md section 3: 2 cm, 45 degrees), used by
 /// the edge matches (paper IV-D) and the dense term's association (paper eq. 3).
 struct SurfaceGate {
   float max_distance = 0.02f;  ///< metres

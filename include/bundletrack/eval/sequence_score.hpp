@@ -9,7 +9,7 @@
 
 namespace bundletrack {
 
-/// Accuracy of a tracked sequence against ground truth (DESIGN.md section 6).
+/// Accuracy of a tracked sequence against ground truth (docs/DESIGN.md section 6).
 struct SequenceScore {
   double add_auc = 0.0;  ///< ADD AUC on [0, 10 cm], x100
   double adds_auc = 0.0;  ///< ADD-S AUC on [0, 10 cm], x100
