@@ -150,10 +150,6 @@ int main(int argc, char** argv) {
       return 2;
     }
   }
-  if (options.features != "sift" && options.features != "orb" && options.features != "akaze") {
-    std::fprintf(stderr, "error: --features: '%s' is not sift, orb or akaze\n%s", options.features.c_str(), usage);
-    return 2;
-  }
   const int frames = options.frames;
   try {
     if (options.sequences.empty()) {

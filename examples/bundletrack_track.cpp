@@ -262,9 +262,6 @@ int main(int argc, char** argv) {
       return 0;
     }
     if (options.sequence.empty() || options.out.empty()) fail("--sequence and --out are required");
-    if (config.tracker != "coarse" && config.tracker != "full") fail("unknown tracker '" + config.tracker + "'");
-    if (config.features != "sift" && config.features != "orb" && config.features != "akaze")
-      fail("unknown features '" + config.features + "'");
     const bt::io::YcbineoatSequence sequence(options.sequence, config.sequence);
     const std::unique_ptr<bt::AnyTracker> tracker = bt::makeTracker(config, sequence.camera().cast<float>());
     return run(*tracker, sequence, options);

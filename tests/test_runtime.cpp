@@ -73,6 +73,14 @@ TEST_CASE("makeTracker applies the settings it is given and the coarse tracker i
   CHECK(largestDifference(poses(*bt::makeTracker(tight, kCamera), frames), poses(composed, frames)) > 1e-6);
 }
 
+TEST_CASE("serial and parallel execution give bit-identical poses") {
+  const int frames = 10;
+  bt::Config serial;
+  serial.execution = bt::Execution::Serial;
+  const auto one_thread = bt::makeTracker(serial, kCamera), all_cores = bt::makeTracker(bt::Config(), kCamera);
+  CHECK(largestDifference(poses(*one_thread, frames), poses(*all_cores, frames)) == 0.0);
+}
+
 TEST_CASE("makeTracker refuses combinations that do not exist, naming the keys") {
   const auto problem = [](const bt::Config& config) -> std::string {
     try {

@@ -3,9 +3,9 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <numbers>
 #include <vector>
 
+#include "bundletrack/core/angles.hpp"
 #include "bundletrack/core/se3.hpp"
 #include "bundletrack/eval/kd_tree.hpp"
 
@@ -31,7 +31,7 @@ inline double averageDistanceSymmetric(const std::vector<Eigen::Vector3f>& model
 }
 
 inline double rotationErrorDeg(const SE3d& T_true, const SE3d& T_est) {
-  return rotationGeodesic(T_true.rotation(), T_est.rotation()) * 180.0 / std::numbers::pi;
+  return degrees(rotationGeodesic(T_true.rotation(), T_est.rotation()));
 }
 
 inline double translationError(const SE3d& T_true, const SE3d& T_est) {

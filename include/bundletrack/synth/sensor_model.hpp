@@ -1,11 +1,11 @@
 #pragma once
 
 #include <cmath>
-#include <numbers>
 #include <random>
 
 #include <opencv2/core.hpp>
 
+#include "bundletrack/core/angles.hpp"
 #include "bundletrack/synth/renderer.hpp"
 
 namespace bundletrack::synth {
@@ -36,7 +36,7 @@ inline void applySensorModel(const RenderBuffers& clean, const PinholeCamerad& c
   std::mt19937 rng(seed);
   std::normal_distribution<double> gauss(0.0, 1.0);
   std::uniform_real_distribution<double> uniform(0.0, 1.0);
-  const double cos_grazing = std::cos(s.grazing_angle_deg * std::numbers::pi / 180.0);
+  const double cos_grazing = std::cos(radians(s.grazing_angle_deg));
   const double fb = camera.fx * s.baseline;
   depth = cv::Mat(clean.depth.size(), CV_32FC1, cv::Scalar(0));
   for (int v = 0; v < depth.rows; ++v) {
