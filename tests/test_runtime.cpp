@@ -102,7 +102,7 @@ TEST_CASE("makeTracker refuses combinations that do not exist, naming the keys")
   CHECK(problem(coarse_gpu).find("compute.device = gpu") != std::string::npos);
   bt::Config unknown;
   unknown.features = "surf";
-  CHECK(problem(unknown) == "features.type = 'surf' is not one of its choices");
+  CHECK(problem(unknown) == "features.type = 'surf': expected sift | orb | akaze");
   bt::Config gpu;
   gpu.device = "gpu";
   const std::string no_gpu = problem(gpu);

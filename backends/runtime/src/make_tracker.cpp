@@ -14,8 +14,8 @@ namespace {
 void requireKnownChoices(Config config) {
   for (const ConfigEntry& entry : configEntries(config)) {
     const auto* choice = std::get_if<ConfigChoice>(&entry.value);
-    if (choice && std::find(choice->names.begin(), choice->names.end(), choice->get()) == choice->names.end())
-      throw std::invalid_argument(entry.name() + " = '" + choice->get() + "' is not one of its choices");
+    if (!choice || std::find(choice->names.begin(), choice->names.end(), choice->get()) != choice->names.end()) continue;
+    throw std::invalid_argument(entry.name() + " = '" + choice->get() + "': expected " + choice->alternatives());
   }
 }
 

@@ -49,6 +49,13 @@ struct ConfigChoice {
   std::vector<std::string> names;
   std::function<std::string()> get;
   std::function<void(const std::string&)> set;
+
+  /// The names, e.g. "sift | orb | akaze".
+  std::string alternatives(const char* separator = " | ") const {
+    std::string out;
+    for (const std::string& n : names) out += (out.empty() ? "" : separator) + n;
+    return out;
+  }
 };
 
 /// One setting: section.key, where it lives (a number of some type, or a choice), its valid range

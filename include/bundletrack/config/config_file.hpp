@@ -19,12 +19,6 @@ namespace bundletrack {
 
 namespace detail {
 
-inline std::string joined(const std::vector<std::string>& names, const char* separator) {
-  std::string out;
-  for (const std::string& n : names) out += (out.empty() ? "" : separator) + n;
-  return out;
-}
-
 /// A setting's value as the YAML reader reads it back: the shortest text of a number that
 /// round-trips, `.inf`, or a choice's name.
 inline std::string valueText(const ConfigEntry& entry) {
@@ -102,7 +96,7 @@ inline Config loadConfig(const std::filesystem::path& path) {
       if (const auto* choice = std::get_if<ConfigChoice>(&entry->value)) {
         const std::string value = node.isString() ? std::string(node) : std::string();
         if (std::find(choice->names.begin(), choice->names.end(), value) == choice->names.end())
-          throw InputError(path, name + " = '" + value + "': expected " + detail::joined(choice->names, " | "));
+          throw InputError(path, name + " = '" + value + "': expected " + choice->alternatives());
         choice->set(value);
       } else {
         detail::setNumber(*entry, node, path);
@@ -120,7 +114,7 @@ inline std::string printConfig(Config config) {
   for (const ConfigEntry& entry : configEntries(config)) {
     if (section != entry.section) out << (section = entry.section) << ":\n";
     out << "  # " << entry.meaning;
-    if (const auto* choice = std::get_if<ConfigChoice>(&entry.value)) out << " (" << detail::joined(choice->names, " | ") << ")";
+    if (const auto* choice = std::get_if<ConfigChoice>(&entry.value)) out << " (" << choice->alternatives() << ")";
     else if (*entry.unit) out << " [" << entry.unit << "]";
     out << "\n  " << entry.key << ": " << detail::valueText(entry) << "\n";
   }
@@ -134,7 +128,7 @@ inline std::string settingsTable() {
   out << "| key | default | unit | meaning |\n|---|---|---|---|\n";
   for (const ConfigEntry& entry : configEntries(defaults)) {
     out << "| `" << entry.name() << "` | " << detail::valueText(entry) << " | " << entry.unit << " | " << entry.meaning;
-    if (const auto* choice = std::get_if<ConfigChoice>(&entry.value)) out << " (" << detail::joined(choice->names, ", ") << ")";
+    if (const auto* choice = std::get_if<ConfigChoice>(&entry.value)) out << " (" << choice->alternatives(", ") << ")";
     out << " |\n";
   }
   return out.str();
