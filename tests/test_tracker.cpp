@@ -1,12 +1,21 @@
-// The full tracker against exact synthetic ground truth, and against the coarse tracker.
+// The full tracker against exact synthetic ground truth and against the coarse tracker; trackers
+// composed at run time (makeTracker) against the same ones composed at compile time; a residual
+// term from outside the library in a tracker's energy. (One translation unit: the trackers'
+// instantiations are compiled once for all of them.)
 #include <doctest/doctest.h>
 
+#include <random>
+#include <stdexcept>
+
+#include "bundletrack/default_tracker.hpp"
 #include "bundletrack/eval/mask_iou.hpp"
 #include "bundletrack/eval/sequence_score.hpp"
-#include "bundletrack/synth/synthetic_sequence.hpp"
-#include "bundletrack/default_tracker.hpp"
 #include "bundletrack/masks/propagated_masks.hpp"
+#include "bundletrack/runtime/make_tracker.hpp"
 #include "bundletrack/solvers/dense_ldlt.hpp"
+#include "bundletrack/synth/synthetic_sequence.hpp"
+#include "cost_gradient.hpp"
+#include "feature_point_to_plane.hpp"
 
 namespace bt = bundletrack;
 namespace synth = bundletrack::synth;
@@ -17,11 +26,12 @@ struct Run {
   bt::SequenceScore score;
   int lost = 0, tracked = 0;
   double mean_mask_iou = 0.0;  ///< against the renderer's mask where the filtered depth is valid
+  std::vector<bt::SE3d> poses;
 };
 
 /// Tracks the scene; with `first_mask_only` every frame after the first comes without its mask.
 template <typename Tracker>
-Run track(Tracker tracker, const synth::SyntheticScene& scene, const std::vector<Eigen::Vector3f>& model,
+Run track(Tracker&& tracker, const synth::SyntheticScene& scene, const std::vector<Eigen::Vector3f>& model,
           bool first_mask_only = false) {
   std::vector<bt::SE3d> truth, estimate;
   Run run;
@@ -39,8 +49,34 @@ Run track(Tracker tracker, const synth::SyntheticScene& scene, const std::vector
   }
   run.mean_mask_iou /= scene.settings().frames;
   run.score = bt::scoreSequence(model, truth, estimate);
+  run.poses = std::move(estimate);
   return run;
 }
+
+double largestDifference(const Run& a, const Run& b) {
+  REQUIRE(a.poses.size() == b.poses.size());
+  double largest = 0.0;
+  for (std::size_t i = 0; i < a.poses.size(); ++i)
+    largest = std::max(largest, (a.poses[i].matrix() - b.poses[i].matrix()).cwiseAbs().maxCoeff());
+  return largest;
+}
+
+/// The first `frames` frames of the default synthetic sequence (hand-held box).
+struct ShortScene {
+  explicit ShortScene(int frames) : scene(withFrames(frames)), model(scene.objectMesh().sampleSurface(1000, 1)) {}
+  static synth::SyntheticSequenceSettings withFrames(int frames) {
+    synth::SyntheticSequenceSettings settings;
+    settings.frames = frames;
+    return settings;
+  }
+  bt::PinholeCameraf camera() const { return scene.settings().camera.cast<float>(); }
+
+  synth::SyntheticScene scene;
+  std::vector<Eigen::Vector3f> model;
+};
+
+using PropagatedTracker =
+    bt::Tracker<bt::DefaultEnergy, bt::PCG, bt::SiftFeatures, bt::PropagatedMasks, bt::Ransac, bt::SurfaceAgreement>;
 
 }  // namespace
 
@@ -71,9 +107,7 @@ TEST_CASE("from the first mask alone: propagated masks track the hand-held box a
   const auto model = scene.objectMesh().sampleSurface(1000, 1);
   const auto camera = settings.camera.cast<float>();
   const Run given = track(bt::DefaultTracker(camera), scene, model);
-  using Propagated = bt::Tracker<bt::DefaultEnergy, bt::PCG, bt::SiftFeatures, bt::PropagatedMasks, bt::Ransac,
-                                 bt::SurfaceAgreement>;
-  const Run propagated = track(Propagated(camera), scene, model, true);
+  const Run propagated = track(PropagatedTracker(camera), scene, model, true);
   MESSAGE("given masks: ADD-S " << given.score.adds_auc << "; propagated: ADD-S " << propagated.score.adds_auc
                                 << ", mean mask IoU " << propagated.mean_mask_iou);
   CHECK(propagated.lost == 0);
@@ -162,6 +196,123 @@ TEST_CASE("object out of view for 30 frames, given masks: lost while gone, recov
 }
 
 TEST_CASE("object out of view for 30 frames, first mask only: lost while gone, found again on return") {
-  checkOutOfView<bt::Tracker<bt::DefaultEnergy, bt::PCG, bt::SiftFeatures, bt::PropagatedMasks, bt::Ransac,
-                             bt::SurfaceAgreement>>(true);
+  checkOutOfView<PropagatedTracker>(true);
+}
+
+// Run-time composition: makeTracker against the trackers composed at compile time.
+
+TEST_CASE("makeTracker builds the tracker composed at compile time: the same poses, given or propagated masks") {
+  const ShortScene short_scene(10);
+  const auto& [scene, model] = std::tie(short_scene.scene, short_scene.model);
+  const Run composed = track(bt::DefaultTracker(short_scene.camera()), scene, model);
+  CHECK(largestDifference(track(*bt::makeTracker(bt::Config(), short_scene.camera()), scene, model), composed) == 0.0);
+  bt::Config config;
+  config.masks = "propagated";
+  const Run made = track(*bt::makeTracker(config, short_scene.camera()), scene, model, true);
+  CHECK(largestDifference(made, track(PropagatedTracker(short_scene.camera()), scene, model, true)) == 0.0);
+  // Serial and parallel execution give the same poses, bit for bit.
+  config.execution = bt::Execution::Serial;
+  CHECK(largestDifference(track(*bt::makeTracker(config, short_scene.camera()), scene, model, true), made) == 0.0);
+}
+
+TEST_CASE("makeTracker applies the settings it is given and the coarse tracker it names") {
+  const ShortScene short_scene(6);
+  const auto& [scene, model] = std::tie(short_scene.scene, short_scene.model);
+  bt::Config config;
+  config.tracker = "coarse";
+  const auto made = bt::makeTracker(config, short_scene.camera());
+  CHECK(made->keyframeCount() == 0);
+  CHECK(largestDifference(track(*made, scene, model), track(bt::DefaultCoarseTracker(), scene, model)) == 0.0);
+  // A setting that matters moves the poses: Huber deltas a hundred times smaller.
+  bt::Config tight;
+  tight.dense_loss.delta = tight.feature_loss.delta = 5e-5;
+  const Run composed = track(bt::DefaultTracker(short_scene.camera()), scene, model);
+  CHECK(largestDifference(track(*bt::makeTracker(tight, short_scene.camera()), scene, model), composed) > 1e-6);
+}
+
+TEST_CASE("makeTracker refuses combinations that do not exist, naming the keys") {
+  const bt::PinholeCameraf camera{600.0f, 600.0f, 319.5f, 239.5f};
+  const auto problem = [&](const bt::Config& config) -> std::string {
+    try {
+      bt::makeTracker(config, camera);
+    } catch (const std::invalid_argument& error) {
+      return error.what();
+    } catch (const std::runtime_error& error) {
+      return std::string("runtime: ") + error.what();
+    }
+    return "";
+  };
+  bt::Config coarse_propagated;
+  coarse_propagated.tracker = "coarse";
+  coarse_propagated.masks = "propagated";
+  CHECK(problem(coarse_propagated).find("tracker.type = coarse with masks.source = propagated") != std::string::npos);
+  bt::Config coarse_gpu;
+  coarse_gpu.tracker = "coarse";
+  coarse_gpu.device = "gpu";
+  CHECK(problem(coarse_gpu).find("compute.device = gpu") != std::string::npos);
+  bt::Config unknown;
+  unknown.features = "surf";
+  CHECK(problem(unknown) == "features.type = 'surf': expected sift | orb | akaze");
+  bt::Config gpu;
+  gpu.device = "gpu";
+  const std::string no_gpu = problem(gpu);
+  // On a machine with a device and the backend, the GPU tracker is built.
+  if (!no_gpu.empty()) CHECK(no_gpu.rfind("runtime: compute.device is gpu, but ", 0) == 0);
+}
+
+// A new residual term, written outside the library (feature_point_to_plane.hpp), is one header
+// and one Term in an energy.
+
+static_assert(bt::Residual<bt::testing::FeaturePointToPlane>);
+
+TEST_CASE("a test-only feature point-to-plane term: its normal equations are the finite-difference gradient") {
+  std::mt19937 rng(7);
+  std::normal_distribution<double> normal;
+  const bt::SE3d T_i(bt::SO3d::exp(Eigen::Vector3d(0.3, -0.2, 0.1)), Eigen::Vector3d(0.02, -0.01, 0.7));
+  const bt::SE3d T_j(bt::SO3d::exp(Eigen::Vector3d(0.25, -0.1, 0.3)), Eigen::Vector3d(0.05, 0.01, 0.65));
+  bt::Keyframe ki, kj;
+  std::vector<bt::FeatureMatch> matches;
+  for (int k = 0; k < 40; ++k) {
+    const Eigen::Vector3d p_obj(0.05 * normal(rng), 0.05 * normal(rng), 0.05 * normal(rng));
+    const Eigen::Vector3d n_obj = Eigen::Vector3d(normal(rng), normal(rng), normal(rng)).normalized();
+    ki.features.points.push_back((T_i * p_obj).cast<float>());
+    ki.features.normals.push_back((T_i.rotation() * n_obj).cast<float>());
+    kj.features.points.push_back((T_j * p_obj).cast<float>());
+    kj.features.normals.push_back((T_j.rotation() * n_obj).cast<float>());
+    matches.push_back({k, k});
+  }
+  using Plugin = bt::testing::FeaturePointToPlane;
+  const auto system = [&](const bt::SE3d& A, const bt::SE3d& B) {
+    bt::PairSystem s;
+    Plugin{}.linearise(Plugin::input(bt::EdgeView{ki, kj, matches}), A, B, bt::TrivialLoss{}, 1.0, s);
+    return s;
+  };
+  // Off the true poses, so that the residuals are not zero.
+  const bt::SE3d A = T_i * bt::SE3d::exp((bt::SE3d::Tangent() << 0.003, -0.002, 0.001, 0.02, 0.01, -0.015).finished());
+  const bt::SE3d B = T_j * bt::SE3d::exp((bt::SE3d::Tangent() << -0.001, 0.002, 0.003, -0.01, 0.02, 0.01).finished());
+  const bt::PairSystem at = system(A, B);
+  REQUIRE(at.residuals == 40);
+  const Eigen::Matrix<double, 12, 1> gradient =
+      halfCostGradient([&](const bt::SE3d& T_a, const bt::SE3d& T_b) { return system(T_a, T_b).cost; }, A, B, 1e-7);
+  CAPTURE(gradient.transpose());
+  CAPTURE(at.b.transpose());
+  CHECK((gradient - at.b).norm() <= 1e-6 * at.b.norm());
+}
+
+TEST_CASE("a tracker with the test-only term in its energy tracks the synthetic box") {
+  const ShortScene short_scene(20);
+  const auto& [scene, model] = std::tie(short_scene.scene, short_scene.model);
+  using WithPlugin = bt::Energy<bt::Term<bt::FeaturePointToPoint, bt::HuberLoss>,
+                                bt::Term<bt::testing::FeaturePointToPlane, bt::HuberLoss>,
+                                bt::Term<bt::DensePointToPlane, bt::HuberLoss>>;
+  const Run with_term = track(
+      bt::Tracker<WithPlugin, bt::PCG, bt::SiftFeatures, bt::GivenMasks, bt::Ransac, bt::SurfaceAgreement>(short_scene.camera()),
+      scene, model);
+  const Run without = track(bt::DefaultTracker(short_scene.camera()), scene, model);
+  MESSAGE("with the point-to-plane feature term: ADD-S " << with_term.score.adds_auc
+                                                         << ", largest pose difference to the default "
+                                                         << largestDifference(with_term, without));
+  CHECK(with_term.lost == 0);
+  CHECK(with_term.score.adds_auc >= 95.0);
+  CHECK(largestDifference(with_term, without) > 1e-6);  // the term takes part in the optimisation
 }

@@ -1,6 +1,6 @@
 // Must not compile: a residual that does not say what it reads of an edge (no Input, no input()).
 // The CMake test expects the concept's name in the error.
-#include "bundletrack/default_tracker.hpp"
+#include "bundletrack/energy.hpp"
 
 struct NoInput {
   template <typename Loss>

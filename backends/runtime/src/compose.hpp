@@ -51,9 +51,7 @@ std::unique_ptr<AnyTracker> cpuTracker(const Config& config, const PinholeCamera
                                  std::move(masks), Ransac(ransacSettings(config)), SurfaceAgreement(config.verification)));
 }
 
-// One translation unit each, so that the heavy instantiations compile in parallel.
-std::unique_ptr<AnyTracker> cpuTrackerWithGivenMasks(const Config& config, const PinholeCameraf& camera);
-std::unique_ptr<AnyTracker> cpuTrackerWithPropagatedMasks(const Config& config, const PinholeCameraf& camera);
+/// The full tracker with the GPU policies (gpu_trackers.cpp, where the CUDA backend is built).
 std::unique_ptr<AnyTracker> gpuTracker(const Config& config, const PinholeCameraf& camera);
 
 }  // namespace bundletrack::runtime

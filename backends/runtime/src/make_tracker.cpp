@@ -4,6 +4,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "bundletrack/masks/propagated_masks.hpp"
 #include "compose.hpp"
 
 namespace bundletrack {
@@ -42,8 +43,8 @@ std::unique_ptr<AnyTracker> makeTracker(const Config& config, const PinholeCamer
                                                                    {config.tracking.min_inliers}));
   }
   if (config.device == "gpu") return runtime::gpuTracker(config, camera);
-  if (config.masks == "propagated") return runtime::cpuTrackerWithPropagatedMasks(config, camera);
-  return runtime::cpuTrackerWithGivenMasks(config, camera);
+  if (config.masks == "propagated") return runtime::cpuTracker(config, camera, PropagatedMasks(config.propagated_masks));
+  return runtime::cpuTracker(config, camera, GivenMasks());
 }
 
 }  // namespace bundletrack
