@@ -202,7 +202,7 @@ TEST_CASE("object out of view for 30 frames, first mask only: lost while gone, f
 // Run-time composition: makeTracker against the trackers composed at compile time.
 
 TEST_CASE("makeTracker builds the tracker composed at compile time: the same poses, given or propagated masks") {
-  const ShortScene short_scene(10);
+  const ShortScene short_scene(6);
   const auto& [scene, model] = std::tie(short_scene.scene, short_scene.model);
   const Run composed = track(bt::DefaultTracker(short_scene.camera()), scene, model);
   CHECK(largestDifference(track(*bt::makeTracker(bt::Config(), short_scene.camera()), scene, model), composed) == 0.0);
@@ -300,7 +300,7 @@ TEST_CASE("a test-only feature point-to-plane term: its normal equations are the
 }
 
 TEST_CASE("a tracker with the test-only term in its energy tracks the synthetic box") {
-  const ShortScene short_scene(20);
+  const ShortScene short_scene(12);
   const auto& [scene, model] = std::tie(short_scene.scene, short_scene.model);
   using WithPlugin = bt::Energy<bt::Term<bt::FeaturePointToPoint, bt::HuberLoss>,
                                 bt::Term<bt::testing::FeaturePointToPlane, bt::HuberLoss>,
