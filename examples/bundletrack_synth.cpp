@@ -21,6 +21,8 @@ const char* const kUsage = R"(usage: bundletrack_synth --out DIR [options]
   --out-of-view S N  from frame S the object is carried out of view for N frames, then comes back
                      where its motion has taken it (its masks are empty meanwhile)
   --motion-blur N    average the colour over N instants of the exposure (1 = off)
+  --sensor S         depth noise of structured_light (Kinect v1, Asus Xtion) | active_stereo
+                     (RealSense D4xx) (structured_light; bundletrack::DepthNoise)
   --no-noise         perfect sensor: no depth noise, quantisation, dropouts or colour noise
   --seed N           random seed of textures and sensor noise (1)
 )";
@@ -79,8 +81,13 @@ int main(int argc, char** argv) {
         fail("--out-of-view needs a start frame >= 1 and a frame count >= 1");
     } else if (arg == "--motion-blur") {
       settings.motion_blur_samples = int(number(arg, value()));
+    } else if (arg == "--sensor") {
+      const std::string sensor = value();
+      if (sensor == "structured_light") settings.sensor.depth_noise = bt::DepthNoise::structuredLight();
+      else if (sensor == "active_stereo") settings.sensor.depth_noise = bt::DepthNoise::activeStereo();
+      else fail("unknown sensor '" + sensor + "' (structured_light | active_stereo)");
     } else if (arg == "--no-noise") {
-      settings.sensor = {0, 0, 0.075, 0, 0.2, 4.0, 0.01, 0, 90, 0, 0};
+      settings.sensor = bt::synth::SensorSettings::perfect();
     } else if (arg == "--seed") {
       settings.seed = unsigned(number(arg, value()));
     } else if (arg == "--help" || arg == "-h") {

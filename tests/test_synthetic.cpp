@@ -15,12 +15,7 @@ namespace {
 const bt::PinholeCamerad kCamera{600.0, 600.0, 319.5, 239.5};
 const cv::Size kSize(640, 480);
 
-synth::SensorSettings perfectSensor() {
-  synth::SensorSettings s;
-  s.noise_base = s.noise_quadratic = s.disparity_step = s.edge_dropout = s.random_dropout = s.color_noise = 0.0;
-  s.grazing_angle_deg = 90.0;
-  return s;
-}
+synth::SensorSettings perfectSensor() { return synth::SensorSettings::perfect(); }
 
 // Closest distance from p to triangle abc (Ericson, Real-Time Collision Detection, 5.1.5).
 double pointTriangleDistance(const Eigen::Vector3d& p, const Eigen::Vector3d& a, const Eigen::Vector3d& b,
@@ -142,21 +137,44 @@ TEST_CASE("the mask is exactly the set of pixels whose depth comes from the obje
   CHECK(cv::countNonZero(unoccluded) > cv::countNonZero(mask) + 200);
 }
 
-TEST_CASE("sensor depth noise follows sigma(z) of the structured-light model") {
+TEST_CASE("depth noise presets follow their formulas: structured light (Kinect v1) and active stereo (D435)") {
+  // By hand: 1.2 mm + 1.9 mm/m^2 (z - 0.4)^2, and z^2 0.08 px / (600 px 0.05 m) = z^2 2.667 mm/m^2.
+  const bt::DepthNoise light = bt::DepthNoise::structuredLight(), stereo = bt::DepthNoise::activeStereo();
+  const double f = 600.0;
+  CHECK(light.sigma(0.5, f) == doctest::Approx(0.001219).epsilon(1e-9));
+  CHECK(light.sigma(1.5, f) == doctest::Approx(0.003499).epsilon(1e-9));
+  CHECK(light.sigma(3.0, f) == doctest::Approx(0.014044).epsilon(1e-9));
+  CHECK(stereo.sigma(0.5, f) == doctest::Approx(0.25 * 0.08 / 30.0).epsilon(1e-9));
+  CHECK(stereo.sigma(3.0, f) == doctest::Approx(0.024).epsilon(1e-9));
+  // Disparity quantisation in 1/8 px over 7.5 cm: at 3 m neighbouring levels are z^2 / (8 f b) = 2.5 cm apart.
+  CHECK(light.quantisationStep(3.0, f) == doctest::Approx(0.025).epsilon(1e-9));
+  const double level = light.quantised(2.9871, f);
+  CHECK(std::abs(std::remainder(f * 0.075 / level, 0.125)) < 1e-9);  // a whole number of 1/8 px
+  CHECK(std::abs(level - 2.9871) <= 0.5 * light.quantisationStep(2.9871, f) * 1.01);
+  CHECK(stereo.quantised(2.9871, f) == 2.9871);
+}
+
+TEST_CASE("the synthetic sensor's depth spreads as its preset's sigma(z) at 0.5, 1.5 and 3 m") {
   const cv::Mat texture = synth::noiseTexture(64, 3);
-  const double z = 1.5;
-  const auto clean = synth::Renderer(kCamera, kSize).render(
-      {{Eigen::Vector3d(0, 0, z), Eigen::Vector3d::UnitX(), Eigen::Vector3d::UnitY(), 1.0, &texture, 0}}, {});
-  synth::SensorSettings sensor = perfectSensor();
-  sensor.noise_base = 0.0012;
-  sensor.noise_quadratic = 0.0019;
-  cv::Mat depth, color;
-  synth::applySensorModel(clean, kCamera, sensor, 9, depth, color);
-  cv::Scalar mean, stddev;
-  cv::meanStdDev(depth - clean.depth, mean, stddev);
-  // 307200 samples: the standard deviation's relative standard error is 1/sqrt(2n) = 0.13%.
-  CHECK(stddev[0] == doctest::Approx(sensor.depthSigma(z)).epsilon(0.01));
-  CHECK(std::abs(mean[0]) < 5.0 * sensor.depthSigma(z) / std::sqrt(double(kSize.area())));
+  for (const bool stereo : {false, true}) {
+    for (const double z : {0.5, 1.5, 3.0}) {
+      CAPTURE(stereo);
+      CAPTURE(z);
+      const auto clean = synth::Renderer(kCamera, kSize).render(
+          {{Eigen::Vector3d(0, 0, z), Eigen::Vector3d::UnitX(), Eigen::Vector3d::UnitY(), 1.0, &texture, 0}}, {});
+      synth::SensorSettings sensor = perfectSensor();
+      sensor.depth_noise = stereo ? bt::DepthNoise::activeStereo() : bt::DepthNoise::structuredLight();
+      sensor.depth_noise.disparity_step = 0.0;  // the spread alone (quantisation is checked above)
+      cv::Mat depth, color;
+      synth::applySensorModel(clean, kCamera, sensor, 9, depth, color);
+      cv::Scalar mean, stddev;
+      cv::meanStdDev(depth - clean.depth, mean, stddev);
+      const double sigma = sensor.depth_noise.sigma(z, kCamera.fx);
+      // 307200 samples: the standard deviation's relative standard error is 1/sqrt(2n) = 0.13%.
+      CHECK(stddev[0] == doctest::Approx(sigma).epsilon(0.01));
+      CHECK(std::abs(mean[0]) < 5.0 * sigma / std::sqrt(double(kSize.area())));
+    }
+  }
 }
 
 TEST_CASE("masked sensor depth unprojected with the ground-truth pose lies on the object surface") {
@@ -178,7 +196,8 @@ TEST_CASE("masked sensor depth unprojected with the ground-truth pose lies on th
       }
     }
     REQUIRE(count > 300);
-    const double mean_distance = sum / count, sigma = settings.sensor.depthSigma(depth_sum / count);
+    const double mean_distance = sum / count,
+                 sigma = settings.sensor.depth_noise.sigma(depth_sum / count, kCamera.fx);
     MESSAGE("shape " << int(shape) << ": mean distance " << 1e3 * mean_distance << " mm, sigma(z) " << 1e3 * sigma
                      << " mm over " << count << " points");
     // A Gaussian's mean absolute value is 0.8 sigma; disparity quantisation adds a little and the

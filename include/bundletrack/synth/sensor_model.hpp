@@ -6,19 +6,16 @@
 #include <opencv2/core.hpp>
 
 #include "bundletrack/core/angles.hpp"
+#include "bundletrack/core/depth_noise.hpp"
 #include "bundletrack/synth/renderer.hpp"
 
 namespace bundletrack::synth {
 
-/// A structured-light depth sensor and a colour camera, after Kinect v1 measurements
-/// (Nguyen, Izadi, Lovell, 3DIMPVT 2012: axial sigma(z) = 1.2 mm + 1.9 mm/m^2 (z - 0.4 m)^2;
-/// Khoshelham and Elberink, Sensors 2012: disparity quantised in 1/8 pixel, baseline 7.5 cm).
-/// Every effect can be switched off by zeroing its parameter.
+/// A depth sensor and a colour camera: the depth noise of one of the library's presets
+/// (DepthNoise: structured light by default, Kinect v1 measurements), dropouts at depth edges and
+/// grazing angles, colour noise. Every effect can be switched off by zeroing its parameter.
 struct SensorSettings {
-  double noise_base = 0.0012;  ///< metres
-  double noise_quadratic = 0.0019;  ///< metres per m^2 of (z - 0.4 m)^2
-  double baseline = 0.075;  ///< metres; with the focal length sets the disparity per depth
-  double disparity_step = 0.125;  ///< pixels; depth is quantised in disparity (0: off)
+  DepthNoise depth_noise = DepthNoise::structuredLight();
   double min_range = 0.2, max_range = 4.0;  ///< metres; outside: no reading
   double edge_jump = 0.01;  ///< metres; a 4-neighbour this much farther or closer marks a depth edge
   double edge_dropout = 0.6;  ///< probability that a depth-edge pixel has no reading
@@ -26,7 +23,14 @@ struct SensorSettings {
   double random_dropout = 0.002;  ///< probability of a missing reading anywhere
   double color_noise = 2.0;  ///< grey levels, Gaussian per channel
 
-  double depthSigma(double z) const { return noise_base + noise_quadratic * (z - 0.4) * (z - 0.4); }
+  /// No noise, quantisation, dropouts or colour noise at all.
+  static SensorSettings perfect() {
+    SensorSettings s;
+    s.depth_noise = DepthNoise();
+    s.edge_dropout = s.random_dropout = s.color_noise = 0.0;
+    s.grazing_angle_deg = 90.0;
+    return s;
+  }
 };
 
 /// Turns a clean render into a sensor reading: depth in metres (0 = no reading), BGR 8-bit.
@@ -37,7 +41,6 @@ inline void applySensorModel(const RenderBuffers& clean, const PinholeCamerad& c
   std::normal_distribution<double> gauss(0.0, 1.0);
   std::uniform_real_distribution<double> uniform(0.0, 1.0);
   const double cos_grazing = std::cos(radians(s.grazing_angle_deg));
-  const double fb = camera.fx * s.baseline;
   depth = cv::Mat(clean.depth.size(), CV_32FC1, cv::Scalar(0));
   for (int v = 0; v < depth.rows; ++v) {
     for (int u = 0; u < depth.cols; ++u) {
@@ -55,9 +58,7 @@ inline void applySensorModel(const RenderBuffers& clean, const PinholeCamerad& c
       const cv::Vec3f& n = clean.normal.at<cv::Vec3f>(v, u);
       const Eigen::Vector3d ray = camera.unproject(u, v, 1.0).normalized();
       if (std::abs(ray.dot(Eigen::Vector3d(n[0], n[1], n[2]))) < cos_grazing) continue;
-      double z_noisy = z + s.depthSigma(z) * noise;
-      if (s.disparity_step > 0.0) z_noisy = fb / (std::round(fb / z_noisy / s.disparity_step) * s.disparity_step);
-      depth.at<float>(v, u) = float(z_noisy);
+      depth.at<float>(v, u) = float(s.depth_noise.quantised(z + s.depth_noise.sigma(z, camera.fx) * noise, camera.fx));
     }
   }
   cv::Mat noisy = clean.color.clone();
