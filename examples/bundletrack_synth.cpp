@@ -17,6 +17,8 @@ const char* const kUsage = R"(usage: bundletrack_synth --out DIR [options]
   --textureless      one flat colour instead of the printed texture
   --motion M         handheld (static camera, object turned up to 180 deg) | orbit (camera orbits) (handheld)
   --speed X          motion speed scale; 1 turns the object by at most 1.9 deg per frame (1)
+  --distance D       metres from the camera to the object (hand-held: the centre of its motion;
+                     orbit: at the start); default the motion's own, 0.73 m / about 0.7 m
   --occluder         an arm passes in front of the object around the middle frame
   --out-of-view S N  from frame S the object is carried out of view for N frames, then comes back
                      where its motion has taken it (its masks are empty meanwhile)
@@ -72,6 +74,9 @@ int main(int argc, char** argv) {
       else fail("unknown motion '" + motion + "'");
     } else if (arg == "--speed") {
       settings.speed = number(arg, value());
+    } else if (arg == "--distance") {
+      settings.distance = number(arg, value());
+      if (!(settings.distance > 0.0)) fail("--distance must be positive");
     } else if (arg == "--occluder") {
       settings.occluder = true;
     } else if (arg == "--out-of-view") {

@@ -177,6 +177,31 @@ TEST_CASE("the synthetic sensor's depth spreads as its preset's sigma(z) at 0.5,
   }
 }
 
+TEST_CASE("the synthetic distance option places the camera that far from the object, hand-held and orbiting") {
+  for (const auto motion : {synth::Motion::HandHeld, synth::Motion::CameraOrbit}) {
+    for (const double distance : {0.5, 3.0}) {
+      CAPTURE(int(motion));
+      CAPTURE(distance);
+      synth::SyntheticSequenceSettings settings;
+      settings.frames = 1;
+      settings.motion = motion;
+      settings.distance = distance;
+      const synth::SyntheticScene scene(settings);
+      // Frame 0: the hand-held object sits at the centre of its motion (no drift yet).
+      CHECK(scene.T_cam_obj(0).translation().norm() == doctest::Approx(distance).epsilon(1e-12));
+      // The object is in view, at that depth: the median masked depth lies within its size.
+      const synth::SyntheticFrame f = scene.frame(0);
+      std::vector<float> depths;
+      for (int v = 0; v < f.depth.rows; ++v)
+        for (int u = 0; u < f.depth.cols; ++u)
+          if (f.mask.at<uchar>(v, u) && f.depth.at<float>(v, u) > 0.0f) depths.push_back(f.depth.at<float>(v, u));
+      REQUIRE(depths.size() > 50);
+      std::nth_element(depths.begin(), depths.begin() + std::ptrdiff_t(depths.size() / 2), depths.end());
+      CHECK(std::abs(depths[depths.size() / 2] - distance) < 0.12);
+    }
+  }
+}
+
 TEST_CASE("masked sensor depth unprojected with the ground-truth pose lies on the object surface") {
   for (const auto shape : {synth::Shape::Box, synth::Shape::Cylinder, synth::Shape::Mug}) {
     synth::SyntheticSequenceSettings settings;

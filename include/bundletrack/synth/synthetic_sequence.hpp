@@ -31,6 +31,10 @@ struct SyntheticSequenceSettings {
   bool textureless = false;  ///< one flat colour instead of the printed texture
   Motion motion = Motion::HandHeld;
   double speed = 1.0;  ///< scales the motion's phase rate (see HandHeldMotion)
+  /// Metres from the camera to the object (hand-held: to the centre of its motion; orbit: at the
+  /// start, the whole orbit scaled about the object); 0: the motion's own, 0.73 m hand-held and
+  /// 0.5-0.7 m orbiting.
+  double distance = 0.0;
   bool occluder = false;  ///< an arm passes between camera and object around the middle frame
   int hidden_start = -1;  ///< from this frame the hand carries the object out of view (-1: never) ...
   int hidden_frames = 0;  ///< ... for this many frames; it comes back where its motion has taken it
@@ -64,6 +68,8 @@ class SyntheticScene {
         occluder_texture_(noiseTexture(128, s_.seed + 37, 0.3)) {
     if (s_.frames <= 0) throw InputError("synthetic sequence", "frames must be positive");
     if (!(s_.speed > 0.0)) throw InputError("synthetic sequence", "speed must be positive");
+    if (!(s_.distance >= 0.0) || s_.distance > 10.0)
+      throw InputError("synthetic sequence", "distance must be 0 (the motion's own) or up to 10 m");
     if (s_.motion_blur_samples < 1) throw InputError("synthetic sequence", "motion_blur_samples must be >= 1");
   }
 
@@ -81,8 +87,16 @@ class SyntheticScene {
   }
 
   SE3d T_world_cam(double frame) const {
-    if (s_.motion == Motion::HandHeld) return HandHeldMotion().T_world_cam;
-    return CameraOrbitMotion().T_world_cam(frame, s_.speed, T_world_obj(frame).translation());
+    if (s_.motion == Motion::HandHeld) {
+      const HandHeldMotion motion;
+      return s_.distance > 0.0 ? motion.cameraAt(s_.distance) : motion.T_world_cam;
+    }
+    const Eigen::Vector3d target = T_world_obj(frame).translation();
+    const SE3d T = CameraOrbitMotion().T_world_cam(frame, s_.speed, target);
+    if (s_.distance <= 0.0) return T;
+    // The whole orbit scaled about the object so that it starts `distance` away.
+    const double scale = s_.distance / (CameraOrbitMotion().T_world_cam(0.0, s_.speed, target).translation() - target).norm();
+    return SE3d(T.rotation(), target + scale * (T.translation() - target));
   }
 
   SE3d T_cam_obj(double frame) const { return T_world_cam(frame).inverse() * T_world_obj(frame); }

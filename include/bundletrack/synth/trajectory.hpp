@@ -29,7 +29,11 @@ inline double motionPhase(double frame, double speed) { return speed * frame * 2
 /// per frame at speed 1), wobbles by up to 11 deg about the other axes and drifts by a few cm.
 struct HandHeldMotion {
   Eigen::Vector3d centre = Eigen::Vector3d(0.0, 0.0, 0.25);
-  SE3d T_world_cam = lookAt(Eigen::Vector3d(0.0, -0.7, 0.45), Eigen::Vector3d(0.0, 0.0, 0.25));
+  Eigen::Vector3d eye = Eigen::Vector3d(0.0, -0.7, 0.45);  ///< 0.73 m from the centre
+  SE3d T_world_cam = lookAt(eye, centre);
+
+  /// The camera on the same line of sight, `distance` metres from the centre.
+  SE3d cameraAt(double distance) const { return lookAt(centre + distance * (eye - centre).normalized(), centre); }
 
   SE3d T_world_obj(double frame, double speed) const {
     const double phase = motionPhase(frame, speed);
