@@ -202,6 +202,26 @@ TEST_CASE("the synthetic distance option places the camera that far from the obj
   }
 }
 
+TEST_CASE("the synthetic size option scales the object to the bounding-box diagonal asked for") {
+  const auto diagonal = [](const synth::TriangleMesh& mesh) {
+    Eigen::AlignedBox3d bounds;
+    for (const auto& p : mesh.positions) bounds.extend(p);
+    return Eigen::Vector3d(bounds.diagonal());
+  };
+  for (const auto shape : {synth::Shape::Box, synth::Shape::Cylinder, synth::Shape::Mug}) {
+    CAPTURE(int(shape));
+    synth::SyntheticSequenceSettings settings;
+    settings.frames = 1;
+    settings.shape = shape;
+    const Eigen::Vector3d own = diagonal(synth::SyntheticScene(settings).objectMesh());
+    MESSAGE("shape " << int(shape) << ": own diagonal " << own.norm() << " m");
+    settings.size = 0.7;
+    const Eigen::Vector3d scaled = diagonal(synth::SyntheticScene(settings).objectMesh());
+    CHECK(scaled.norm() == doctest::Approx(0.7).epsilon(1e-12));
+    CHECK((scaled / scaled.norm() - own / own.norm()).norm() < 1e-12);  // the same proportions
+  }
+}
+
 TEST_CASE("masked sensor depth unprojected with the ground-truth pose lies on the object surface") {
   for (const auto shape : {synth::Shape::Box, synth::Shape::Cylinder, synth::Shape::Mug}) {
     synth::SyntheticSequenceSettings settings;

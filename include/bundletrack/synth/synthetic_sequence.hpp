@@ -8,6 +8,7 @@
 #include <optional>
 #include <string>
 
+#include <Eigen/Geometry>
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
 
@@ -35,6 +36,9 @@ struct SyntheticSequenceSettings {
   /// start, the whole orbit scaled about the object); 0: the motion's own, 0.73 m hand-held and
   /// 0.5-0.7 m orbiting.
   double distance = 0.0;
+  /// The object's size: the diagonal of its bounding box in metres (the mesh scaled uniformly);
+  /// 0: the shape's own (box 0.20 m, can 0.15 m, mug 0.17 m).
+  double size = 0.0;
   bool occluder = false;  ///< an arm passes between camera and object around the middle frame
   int hidden_start = -1;  ///< from this frame the hand carries the object out of view (-1: never) ...
   int hidden_frames = 0;  ///< ... for this many frames; it comes back where its motion has taken it
@@ -60,7 +64,7 @@ class SyntheticScene {
   explicit SyntheticScene(SyntheticSequenceSettings settings)
       : s_(std::move(settings)),
         renderer_(s_.camera, s_.image_size),
-        object_mesh_(makeObjectMesh(s_.shape)),
+        object_mesh_(makeObjectMesh(s_.shape, s_.size)),
         occluder_mesh_(makeCylinder(0.035, 0.9, 32)),
         object_texture_(s_.textureless ? plainTexture({60, 140, 200}) : richTexture(1024, s_.seed)),
         table_texture_(noiseTexture(512, s_.seed + 11, 0.8)),
@@ -70,6 +74,8 @@ class SyntheticScene {
     if (!(s_.speed > 0.0)) throw InputError("synthetic sequence", "speed must be positive");
     if (!(s_.distance >= 0.0) || s_.distance > 10.0)
       throw InputError("synthetic sequence", "distance must be 0 (the motion's own) or up to 10 m");
+    if (!(s_.size >= 0.0) || s_.size > 5.0)
+      throw InputError("synthetic sequence", "size must be 0 (the shape's own) or up to 5 m");
     if (s_.motion_blur_samples < 1) throw InputError("synthetic sequence", "motion_blur_samples must be >= 1");
   }
 
@@ -136,12 +142,23 @@ class SyntheticScene {
   }
 
  private:
-  static TriangleMesh makeObjectMesh(Shape shape) {
+  static TriangleMesh makeShape(Shape shape) {
     switch (shape) {
       case Shape::Cylinder: return makeCylinder(0.035, 0.11);
       case Shape::Mug: return makeMug(0.04, 0.095, 0.006);
       default: return makeBox({0.10, 0.07, 0.16});
     }
+  }
+
+  /// The shape, scaled about its origin so that its bounding-box diagonal is `size` (0: as it is).
+  static TriangleMesh makeObjectMesh(Shape shape, double size) {
+    TriangleMesh mesh = makeShape(shape);
+    if (size <= 0.0) return mesh;
+    Eigen::AlignedBox3d bounds;
+    for (const auto& p : mesh.positions) bounds.extend(p);
+    const double scale = size / bounds.diagonal().norm();
+    for (auto& p : mesh.positions) p *= scale;
+    return mesh;
   }
 
   double restingHeight() const {
