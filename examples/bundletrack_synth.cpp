@@ -13,9 +13,9 @@ namespace {
 
 const char* const kUsage = R"(usage: bundletrack_synth --out DIR [options]
   --frames N         number of frames (300)
-  --shape S          box | cylinder | mug (box)
+  --shape S          box | cylinder | mug | chair (0.83 m: legs, seat and back; use with --distance) (box)
   --size S           the object's bounding-box diagonal in metres (the shape scaled; default its
-                     own: box 0.20, cylinder 0.15, mug 0.17)
+                     own: box 0.20, cylinder 0.15, mug 0.17, chair 0.83)
   --textureless      one flat colour instead of the printed texture
   --motion M         handheld (static camera, object turned up to 180 deg) | orbit (camera orbits) (handheld)
   --speed X          motion speed scale; 1 turns the object by at most 1.9 deg per frame (1)
@@ -66,6 +66,7 @@ int main(int argc, char** argv) {
       if (shape == "box") settings.shape = bt::synth::Shape::Box;
       else if (shape == "cylinder") settings.shape = bt::synth::Shape::Cylinder;
       else if (shape == "mug") settings.shape = bt::synth::Shape::Mug;
+      else if (shape == "chair") settings.shape = bt::synth::Shape::Chair;
       else fail("unknown shape '" + shape + "'");
     } else if (arg == "--size") {
       settings.size = number(arg, value());

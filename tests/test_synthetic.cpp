@@ -208,7 +208,7 @@ TEST_CASE("the synthetic size option scales the object to the bounding-box diago
     for (const auto& p : mesh.positions) bounds.extend(p);
     return Eigen::Vector3d(bounds.diagonal());
   };
-  for (const auto shape : {synth::Shape::Box, synth::Shape::Cylinder, synth::Shape::Mug}) {
+  for (const auto shape : {synth::Shape::Box, synth::Shape::Cylinder, synth::Shape::Mug, synth::Shape::Chair}) {
     CAPTURE(int(shape));
     synth::SyntheticSequenceSettings settings;
     settings.frames = 1;
@@ -220,6 +220,26 @@ TEST_CASE("the synthetic size option scales the object to the bounding-box diago
     CHECK(scaled.norm() == doctest::Approx(0.7).epsilon(1e-12));
     CHECK((scaled / scaled.norm() - own / own.norm()).norm() < 1e-12);  // the same proportions
   }
+}
+
+TEST_CASE("the chair: legs, seat and back within its 0.36 x 0.36 x 0.66 m bounds, seen with gaps at 2.5 m") {
+  const synth::TriangleMesh chair = synth::makeChair();
+  Eigen::AlignedBox3d bounds;
+  for (const auto& p : chair.positions) bounds.extend(p);
+  CHECK((bounds.diagonal() - Eigen::Vector3d(0.36, 0.36, 0.66)).norm() < 1e-12);
+  CHECK(bounds.center().norm() < 1e-12);
+  CHECK(chair.positions.size() == 6 * 24);  // six boxes
+  synth::SyntheticSequenceSettings settings;
+  settings.frames = 1;
+  settings.shape = synth::Shape::Chair;
+  settings.motion = synth::Motion::CameraOrbit;
+  settings.distance = 2.5;
+  const synth::SyntheticFrame f = synth::SyntheticScene(settings).frame(0);
+  const int area = cv::countNonZero(f.mask);
+  const cv::Rect box = cv::boundingRect(f.mask);
+  MESSAGE("chair at 2.5 m: " << area << " mask pixels in a " << box.width << " x " << box.height << " box");
+  CHECK(area > 1000);
+  CHECK(area < 0.8 * box.area());  // between the legs and under the seat the background shows
 }
 
 TEST_CASE("masked sensor depth unprojected with the ground-truth pose lies on the object surface") {

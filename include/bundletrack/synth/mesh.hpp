@@ -172,4 +172,28 @@ inline TriangleMesh makeMug(double radius, double height, double wall, int segme
   return mesh;
 }
 
+/// A chair, the large weakly structured object of the stress matrix: four legs, a seat and a
+/// back (boxes; 0.36 x 0.36 m footprint, seat at 0.33-0.36 m, back up to 0.66 m, diagonal 0.83 m),
+/// centred on its bounding box, z up, the back on the -y side.
+inline TriangleMesh makeChair() {
+  const double width = 0.36, leg = 0.03, leg_height = 0.33, seat = 0.03, back = 0.30, top = leg_height + seat + back;
+  const auto part = [&](const Eigen::Vector3d& size, const Eigen::Vector3d& centre) {
+    TriangleMesh box = makeBox(size);
+    for (auto& p : box.positions) p += centre - Eigen::Vector3d(0.0, 0.0, 0.5 * top);
+    return box;
+  };
+  TriangleMesh chair;
+  const auto append = [&](const TriangleMesh& box) {
+    const int first = int(chair.positions.size());
+    for (std::size_t k = 0; k < box.positions.size(); ++k) chair.addVertex(box.positions[k], box.normals[k], box.uvs[k]);
+    for (const auto& t : box.triangles) chair.triangles.push_back({first + t[0], first + t[1], first + t[2]});
+  };
+  const double corner = 0.5 * (width - leg);
+  for (const double x : {-corner, corner})
+    for (const double y : {-corner, corner}) append(part({leg, leg, leg_height}, {x, y, 0.5 * leg_height}));
+  append(part({width, width, seat}, {0.0, 0.0, leg_height + 0.5 * seat}));
+  append(part({width, leg, back}, {0.0, -corner, leg_height + seat + 0.5 * back}));
+  return chair;
+}
+
 }  // namespace bundletrack::synth

@@ -21,7 +21,7 @@
 
 namespace bundletrack::synth {
 
-enum class Shape { Box, Cylinder, Mug };
+enum class Shape { Box, Cylinder, Mug, Chair };
 enum class Motion { HandHeld, CameraOrbit };
 
 struct SyntheticSequenceSettings {
@@ -37,7 +37,7 @@ struct SyntheticSequenceSettings {
   /// 0.5-0.7 m orbiting.
   double distance = 0.0;
   /// The object's size: the diagonal of its bounding box in metres (the mesh scaled uniformly);
-  /// 0: the shape's own (box 0.20 m, can 0.15 m, mug 0.17 m).
+  /// 0: the shape's own (box 0.20 m, can 0.15 m, mug 0.17 m, chair 0.83 m).
   double size = 0.0;
   bool occluder = false;  ///< an arm passes between camera and object around the middle frame
   int hidden_start = -1;  ///< from this frame the hand carries the object out of view (-1: never) ...
@@ -146,6 +146,7 @@ class SyntheticScene {
     switch (shape) {
       case Shape::Cylinder: return makeCylinder(0.035, 0.11);
       case Shape::Mug: return makeMug(0.04, 0.095, 0.006);
+      case Shape::Chair: return makeChair();
       default: return makeBox({0.10, 0.07, 0.16});
     }
   }
