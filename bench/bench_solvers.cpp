@@ -69,7 +69,7 @@ const bt::PoseGraph& graphOfSize(int size) {
       const bt::MatchGate gate{(graph.poses[b] * graph.poses[a].inverse()).cast<float>(), {}};
       const auto m = sift.match(graph.nodes[a]->features, graph.nodes[b]->features, gate);
       const auto pruned = ransac.estimate(graph.nodes[a]->features, graph.nodes[b]->features, m);
-      std::vector<bt::FeatureMatch>& inliers = graph.current_matches.emplace_back();
+      std::vector<bt::FeatureMatch>& inliers = graph.owned_matches.emplace_back();
       for (const int k : pruned.inliers) inliers.push_back(m[std::size_t(k)]);
       graph.edges.push_back({a, b});
       graph.matches.push_back(&inliers);

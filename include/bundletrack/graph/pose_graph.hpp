@@ -23,14 +23,14 @@ struct PoseGraph {
   PoseGraph() = default;
   PoseGraph(PoseGraph&&) = default;
   PoseGraph& operator=(PoseGraph&&) = default;
-  PoseGraph(const PoseGraph&) = delete;  // matches point into current_matches
+  PoseGraph(const PoseGraph&) = delete;  // matches point into owned_matches
 
   std::vector<const Keyframe*> nodes;
   std::vector<std::size_t> pool_indices;  ///< where the keyframe nodes (all but the last) sit in the pool
   std::vector<SE3d> poses;
   std::vector<GraphEdge> edges;
   std::vector<const std::vector<FeatureMatch>*> matches;  ///< per edge
-  std::deque<std::vector<FeatureMatch>> current_matches;  ///< owned: the current frame's edges (stable addresses)
+  std::deque<std::vector<FeatureMatch>> owned_matches;  ///< correspondences the graph owns (the tracker: the current frame's edges); stable addresses
 
   EdgeView edge(std::size_t e) const { return {*nodes[std::size_t(edges[e].i)], *nodes[std::size_t(edges[e].j)], *matches[e]}; }
 };

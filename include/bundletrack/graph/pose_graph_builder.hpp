@@ -35,7 +35,7 @@ PoseGraph buildPoseGraph(const KeyframePool& pool, std::size_t max_keyframes, co
     for (int b = a + 1; b <= current_node; ++b) {
       const Keyframe& first = *graph.nodes[std::size_t(a)];
       if (b == current_node) {
-        graph.matches.push_back(&graph.current_matches.emplace_back(
+        graph.matches.push_back(&graph.owned_matches.emplace_back(
             first.id == last.id && last.inliers ? std::move(*last.inliers)
                                                 : match_edge(first, current, graph.poses[std::size_t(a)], T_current)));
       } else {

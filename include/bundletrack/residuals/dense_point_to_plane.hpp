@@ -49,11 +49,11 @@ struct DensePointToPlane {
       const cv::Vec3f& pt = t.points.at<cv::Vec3f>(v, u);
       if (pt[2] <= 0.0f) continue;
       const Eigen::Vector3d p_t(pt[0], pt[1], pt[2]);
+      if ((T_s_t * p_t - p_s).squaredNorm() > bounds.max_squared_distance) continue;  // the cheap test first
       const cv::Vec3f& ns = s.normals.at<cv::Vec3f>(cell);
       const cv::Vec3f& nt = t.normals.at<cv::Vec3f>(v, u);
       const Eigen::Vector3d n_s(ns[0], ns[1], ns[2]);
-      if (!bounds.admits((T_s_t * p_t - p_s).squaredNorm(), (R_s_t * Eigen::Vector3d(nt[0], nt[1], nt[2])).dot(n_s)))
-        continue;
+      if ((R_s_t * Eigen::Vector3d(nt[0], nt[1], nt[2])).dot(n_s) < bounds.cos_max_angle) continue;
       const Eigen::Vector3d m = R_s_inv * n_s, a = T_s_inv * p_s, b = T_t_inv * p_t;
       Eigen::Matrix<double, 1, 6> J_s;
       J_s.leftCols<3>() = m.transpose();

@@ -57,10 +57,10 @@ class SurfaceAgreement {
           const cv::Vec3f& pk = other.points.at<cv::Vec3f>(v, u);
           if (pk[2] <= 0.0f) continue;
           landed = true;
+          if ((Eigen::Vector3d(pk[0], pk[1], pk[2]) - q).squaredNorm() > bounds.max_squared_distance) continue;
           const cv::Vec3f& nk = other.normals.at<cv::Vec3f>(v, u);
           const Eigen::Vector3d n = T_k_c[k].rotation() * Eigen::Vector3d(nc[0], nc[1], nc[2]);
-          agrees = bounds.admits((Eigen::Vector3d(pk[0], pk[1], pk[2]) - q).squaredNorm(),
-                                 n.dot(Eigen::Vector3d(nk[0], nk[1], nk[2])));
+          agrees = n.dot(Eigen::Vector3d(nk[0], nk[1], nk[2])) >= bounds.cos_max_angle;
         }
         compared += landed;
         agreeing += agrees;
