@@ -96,6 +96,7 @@ int main(int argc, char** argv) {
       const std::string sensor = value();
       if (sensor == "structured_light") settings.sensor.depth_noise = bt::DepthNoise::structuredLight();
       else if (sensor == "active_stereo") settings.sensor.depth_noise = bt::DepthNoise::activeStereo();
+      else if (sensor == "time_of_flight") settings.sensor.depth_noise = bt::DepthNoise::timeOfFlight();
       else fail("unknown sensor '" + sensor + "' (structured_light | active_stereo)");
     } else if (arg == "--no-noise") {
       settings.sensor = bt::synth::SensorSettings::perfect();

@@ -9,6 +9,7 @@
 #include <fstream>
 #include <iostream>
 #include <string>
+#include <variant>
 
 #include <unistd.h>
 
@@ -36,7 +37,10 @@ const char* const kUsage = R"(usage: bundletrack_track --sequence DIR --out DIR 
   --tracker T        full: pose graph over keyframes (paper IV) | coarse: frame-to-frame RANSAC only (full)
   --depth-scale S    metres per unit of the depth images (0.001)
   --min-inliers N    fewest RANSAC inliers that count as a pose; fewer: the frame is lost (5)
-  --inlier-mm D      RANSAC inlier distance in millimetres (5)
+  --inlier-mm D      RANSAC inlier distance in millimetres (5; widened by the sensor's noise)
+  --sensor S         structured_light (Kinect v1, Xtion) | active_stereo (RealSense D4xx) |
+                     time_of_flight (Azure Kinect): the depth noise every depth tolerance widens
+                     with (sensor.model; structured_light)
   --gpu              matching, dense term, PCG and RANSAC on a CUDA device (compute.device: gpu;
                      needs a build with the CUDA backend and a GPU; keypoints stay on the CPU)
   --propagate-masks  the tracker gets only the first frame's mask and follows the object from it
@@ -52,6 +56,17 @@ const char* const kUsage = R"(usage: bundletrack_track --sequence DIR --out DIR 
 [[noreturn]] void fail(const std::string& message) {
   std::cerr << "error: " << message << "\n" << kUsage;
   std::exit(2);
+}
+
+/// Sets the choice setting `key` to `name` as a command-line option asks; an unknown name fails.
+void setChoice(bt::Config& config, const std::string& key, const std::string& option, const std::string& name) {
+  for (const bt::ConfigEntry& entry : bt::configEntries(config)) {
+    if (entry.name() != key) continue;
+    const auto& choice = std::get<bt::ConfigChoice>(entry.value);
+    if (std::find(choice.names.begin(), choice.names.end(), name) == choice.names.end())
+      fail(option + " '" + name + "': expected " + choice.alternatives());
+    choice.set(name);
+  }
 }
 
 double number(const std::string& option, const std::string& text) {
@@ -235,7 +250,8 @@ int main(int argc, char** argv) {
       std::cout << bt::settingsTable();
       return 0;
     }
-    else if (arg == "--features" || arg == "--depth-scale" || arg == "--min-inliers" || arg == "--inlier-mm")
+    else if (arg == "--features" || arg == "--depth-scale" || arg == "--min-inliers" || arg == "--inlier-mm" ||
+             arg == "--sensor")
       overrides.emplace_back(arg, value());
     else if (arg == "--propagate-masks" || arg == "--gpu") overrides.emplace_back(arg, "");
     else if (arg == "--quiet") options.quiet = true;
@@ -254,6 +270,7 @@ int main(int argc, char** argv) {
       else if (option == "--depth-scale") config.sequence.depth_scale = number(option, text);
       else if (option == "--min-inliers") config.tracking.min_inliers = int(number(option, text));
       else if (option == "--inlier-mm") config.ransac.inlier_distance = float(number(option, text) * 1e-3);
+      else if (option == "--sensor") setChoice(config, "sensor.model", option, text);
       else if (option == "--propagate-masks") config.masks = "propagated";
       else if (option == "--gpu") config.device = "gpu";
     }

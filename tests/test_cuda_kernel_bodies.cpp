@@ -150,7 +150,7 @@ TEST_CASE("GPU RANSAC trial bodies on the host draw, fit and count as the CPU tr
   REQUIRE(matches.size() > 30);
   const bt::MatchedPoints pairs(first, second, matches);
   const bt::RansacSettings settings;
-  const bt::InlierGate gate(settings);
+  const bt::InlierGate gate(settings, bt::NoiseScale::between(first.noise_scale, second.noise_scale));
   const int trials = 300;
   std::vector<bt::SE3d> cpu_fits;
   std::vector<char> cpu_valid;

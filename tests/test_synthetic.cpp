@@ -137,7 +137,7 @@ TEST_CASE("the mask is exactly the set of pixels whose depth comes from the obje
   CHECK(cv::countNonZero(unoccluded) > cv::countNonZero(mask) + 200);
 }
 
-TEST_CASE("depth noise presets follow their formulas: structured light (Kinect v1) and active stereo (D435)") {
+TEST_CASE("depth noise presets follow their formulas: structured light (Kinect v1), active stereo (D435), time of flight (Azure Kinect)") {
   // By hand: 1.2 mm + 1.9 mm/m^2 (z - 0.4)^2, and z^2 0.08 px / (600 px 0.05 m) = z^2 2.667 mm/m^2.
   const bt::DepthNoise light = bt::DepthNoise::structuredLight(), stereo = bt::DepthNoise::activeStereo();
   const double f = 600.0;
@@ -152,18 +152,47 @@ TEST_CASE("depth noise presets follow their formulas: structured light (Kinect v
   CHECK(std::abs(std::remainder(f * 0.075 / level, 0.125)) < 1e-9);  // a whole number of 1/8 px
   CHECK(std::abs(level - 2.9871) <= 0.5 * light.quantisationStep(2.9871, f) * 1.01);
   CHECK(stereo.quantised(2.9871, f) == 2.9871);
+  // Time of flight: linear up to the specified 17 mm at the end of the 3.86 m range.
+  const bt::DepthNoise tof = bt::DepthNoise::timeOfFlight();
+  CHECK(tof.sigma(3.86, f) == doctest::Approx(0.017).epsilon(1e-12));
+  CHECK(tof.sigma(1.0, f) == doctest::Approx(0.017 / 3.86).epsilon(1e-12));
+  // The spread adds the uniform rounding error: sqrt(sigma^2 + step^2 / 12).
+  CHECK(light.spread(3.0, f) == doctest::Approx(std::hypot(0.014044, 0.025 / std::sqrt(12.0))).epsilon(1e-6));
+  CHECK(stereo.spread(3.0, f) == stereo.sigma(3.0, f));
+}
+
+TEST_CASE("the noise scale is the spread over structured light's at 1 m, never below 1") {
+  // Reference by hand: sigma = 1.2 + 1.9 * 0.36 = 1.884 mm, step = 0.125 / (525 * 0.075) = 3.175 mm.
+  const double reference = std::hypot(0.001884, 0.125 / (525.0 * 0.075) / std::sqrt(12.0));
+  CHECK(bt::NoiseScale::referenceSpread() == doctest::Approx(reference).epsilon(1e-9));
+  const bt::NoiseScale light(bt::DepthNoise::structuredLight(), 525.0);
+  CHECK(light.unitDepth() == doctest::Approx(1.0).epsilon(1e-5));  // the reference itself
+  CHECK(light.at(0.5) == 1.0);
+  CHECK(light.at(3.0) == doctest::Approx(bt::DepthNoise::structuredLight().spread(3.0, 525.0) / reference).epsilon(1e-12));
+  CHECK(light.widen(0.01f, 3.0f) == doctest::Approx(0.01 * light.at(3.0)).epsilon(1e-6));
+  CHECK(light.widen(0.01f, 0.7f) == 0.01f);
+  // Stereo with the D435's numbers: z^2 0.08 / (600 0.05) reaches the reference at 0.887 m.
+  const bt::NoiseScale stereo(bt::DepthNoise::activeStereo(), 600.0);
+  CHECK(stereo.unitDepth() == doctest::Approx(std::sqrt(reference * 600.0 * 0.05 / 0.08)).epsilon(1e-5));
+  CHECK(stereo.at(2.0) == doctest::Approx(4.0 * 0.08 / 30.0 / reference).epsilon(1e-9));
+  // The median of the readings decides; a pair's factor is the RMS of the two.
+  CHECK(light.atMedian({0.5f, 3.0f, 3.0f}) == light.at(3.0f));
+  CHECK(light.atMedian({}) == 1.0);
+  CHECK(bt::NoiseScale::between(1.0, 7.0) == doctest::Approx(5.0));
 }
 
 TEST_CASE("the synthetic sensor's depth spreads as its preset's sigma(z) at 0.5, 1.5 and 3 m") {
   const cv::Mat texture = synth::noiseTexture(64, 3);
-  for (const bool stereo : {false, true}) {
+  for (const bt::DepthNoise& preset :
+       {bt::DepthNoise::structuredLight(), bt::DepthNoise::activeStereo(), bt::DepthNoise::timeOfFlight()}) {
     for (const double z : {0.5, 1.5, 3.0}) {
-      CAPTURE(stereo);
+      CAPTURE(preset.subpixel);
+      CAPTURE(preset.linear);
       CAPTURE(z);
       const auto clean = synth::Renderer(kCamera, kSize).render(
           {{Eigen::Vector3d(0, 0, z), Eigen::Vector3d::UnitX(), Eigen::Vector3d::UnitY(), 1.0, &texture, 0}}, {});
       synth::SensorSettings sensor = perfectSensor();
-      sensor.depth_noise = stereo ? bt::DepthNoise::activeStereo() : bt::DepthNoise::structuredLight();
+      sensor.depth_noise = preset;
       sensor.depth_noise.disparity_step = 0.0;  // the spread alone (quantisation is checked above)
       cv::Mat depth, color;
       synth::applySensorModel(clean, kCamera, sensor, 9, depth, color);

@@ -182,10 +182,12 @@ class Tracker {
                                });
   }
 
-  /// Feature correspondences of an edge (paper IV-D): matches gated by the current poses, pruned
-  /// by RANSAC; fewer than min_edge_correspondences count as none.
+  /// Feature correspondences of an edge (paper IV-D): matches gated by the current poses (the gate
+  /// widened for the sensor's noise), pruned by RANSAC; fewer than min_edge_correspondences count
+  /// as none.
   std::vector<FeatureMatch> edgeCorrespondences(const Keyframe& a, const Keyframe& b, const SE3d& T_a, const SE3d& T_b) {
-    PairRegistration pair = registerPair(a.features, b.features, MatchGate{(T_b * T_a.inverse()).cast<float>(), settings_.edge_gate});
+    const SurfaceGate gate = settings_.edge_gate.widened(NoiseScale::between(a.features.noise_scale, b.features.noise_scale));
+    PairRegistration pair = registerPair(a.features, b.features, MatchGate{(T_b * T_a.inverse()).cast<float>(), gate});
     if (int(pair.inliers.size()) < settings_.min_edge_correspondences) return {};
     return std::move(pair.inliers);
   }

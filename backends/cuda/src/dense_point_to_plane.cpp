@@ -102,8 +102,9 @@ void DensePointToPlane::lineariseAllWith(std::span<const Input> inputs, std::spa
     const SE3d& T_j = poses[std::size_t(edges[e].j)];
     const detail::DeviceGrid* grid_i = w.grid(in.i);
     const detail::DeviceGrid* grid_j = w.grid(in.j);
-    w.passes.push_back({grid_i, grid_j, detail::directedPass(T_i, T_j, in.j.camera, gate, loss, weight)});
-    w.passes.push_back({grid_j, grid_i, detail::directedPass(T_j, T_i, in.i.camera, gate, loss, weight)});
+    const SurfaceGate widened = gate.widened(NoiseScale::between(in.i.noise_scale, in.j.noise_scale));
+    w.passes.push_back({grid_i, grid_j, detail::directedPass(T_i, T_j, in.j.camera, widened, loss, weight)});
+    w.passes.push_back({grid_j, grid_i, detail::directedPass(T_j, T_i, in.i.camera, widened, loss, weight)});
   }
   w.sums.resize(w.passes.size() * detail::kDenseSums);
   detail::accumulateDense(*w.batch, w.passes.data(), int(w.passes.size()), w.sums.data());

@@ -6,6 +6,8 @@
 
 #include <opencv2/core.hpp>
 
+#include "bundletrack/core/depth_noise.hpp"
+
 namespace bundletrack {
 
 /// Depth clean-up before anything uses the depth (docs/DESIGN.md section 3, after the original code).
@@ -33,8 +35,9 @@ inline void invalidateOutOfRange(cv::Mat& depth, const DepthFilterSettings& s) {
 }
 
 /// Removes isolated readings and the flying pixels of depth edges: a valid pixel goes when at least
-/// erode_ratio of its neighbours are invalid or differ from it by more than erode_depth_diff.
-inline cv::Mat erodeDepth(const cv::Mat& depth, const DepthFilterSettings& s) {
+/// erode_ratio of its neighbours are invalid or differ from it by more than erode_depth_diff
+/// (widened by `noise` at the pixel's depth).
+inline cv::Mat erodeDepth(const cv::Mat& depth, const DepthFilterSettings& s, const NoiseScale& noise = NoiseScale()) {
   CV_Assert(depth.type() == CV_32FC1);
   cv::Mat out = depth.clone();
   const int r = s.erode_radius;
@@ -43,6 +46,7 @@ inline cv::Mat erodeDepth(const cv::Mat& depth, const DepthFilterSettings& s) {
     const int v = pos[0], u = pos[1];
     const float z = depth.at<float>(v, u);
     if (z <= 0.0f || neighbours == 0) return;
+    const float diff = noise.widen(s.erode_depth_diff, z);
     int against = 0;
     for (int dv = -r; dv <= r; ++dv) {
       for (int du = -r; du <= r; ++du) {
@@ -50,7 +54,7 @@ inline cv::Mat erodeDepth(const cv::Mat& depth, const DepthFilterSettings& s) {
         const int vv = v + dv, uu = u + du;
         const bool inside = vv >= 0 && vv < depth.rows && uu >= 0 && uu < depth.cols;
         const float zn = inside ? depth.at<float>(vv, uu) : 0.0f;
-        if (zn <= 0.0f || std::abs(zn - z) > s.erode_depth_diff) ++against;
+        if (zn <= 0.0f || std::abs(zn - z) > diff) ++against;
       }
     }
     if (against >= s.erode_ratio * neighbours) z_out = 0.0f;
@@ -59,11 +63,12 @@ inline cv::Mat erodeDepth(const cv::Mat& depth, const DepthFilterSettings& s) {
 }
 
 /// One pass of edge-preserving smoothing: each valid pixel becomes the Gaussian-weighted mean of
-/// the valid neighbours whose depth lies within smooth_depth_window of its own depth.
+/// the valid neighbours whose depth lies within smooth_depth_window (widened by `noise` at its
+/// depth) of its own depth.
 /// The original code compared with the window's mean depth instead; at a silhouette whose window
 /// is mostly background that mean is background, and the object pixel took the background's depth
 /// (measured on the synthetic sequences: a third of the mask's border pixels moved by > 10 cm).
-inline cv::Mat smoothDepth(const cv::Mat& depth, const DepthFilterSettings& s) {
+inline cv::Mat smoothDepth(const cv::Mat& depth, const DepthFilterSettings& s, const NoiseScale& noise = NoiseScale()) {
   CV_Assert(depth.type() == CV_32FC1);
   cv::Mat out = depth.clone();
   const int r = s.smooth_radius, width = 2 * r + 1;
@@ -79,13 +84,14 @@ inline cv::Mat smoothDepth(const cv::Mat& depth, const DepthFilterSettings& s) {
         const float z = depth.ptr<float>(v)[u];
         if (z <= 0.0f) continue;
         const int u0 = std::max(0, u - r), u1 = std::min(depth.cols - 1, u + r);
+        const float window = noise.widen(s.smooth_depth_window, z);
         // Invalid readings are 0 and fail the window test, which keeps the inner loop branch-free.
         float weighted = 0.0f, weights = 0.0f;
         for (int vv = v0; vv <= v1; ++vv) {
           const float* row = depth.ptr<float>(vv);
           const float* w = &spatial[std::size_t((vv - v + r) * width - u + r)];
           for (int uu = u0; uu <= u1; ++uu) {
-            const float use = float(std::abs(row[uu] - z) < s.smooth_depth_window);
+            const float use = float(std::abs(row[uu] - z) < window);
             weighted += use * w[uu] * row[uu];
             weights += use * w[uu];
           }
@@ -98,11 +104,11 @@ inline cv::Mat smoothDepth(const cv::Mat& depth, const DepthFilterSettings& s) {
 }
 
 /// The whole clean-up: range check, erosion, then smooth_passes smoothing passes.
-inline cv::Mat filterDepth(const cv::Mat& raw_depth, const DepthFilterSettings& s) {
+inline cv::Mat filterDepth(const cv::Mat& raw_depth, const DepthFilterSettings& s, const NoiseScale& noise = NoiseScale()) {
   cv::Mat depth = raw_depth.clone();
   invalidateOutOfRange(depth, s);
-  depth = erodeDepth(depth, s);
-  for (int pass = 0; pass < s.smooth_passes; ++pass) depth = smoothDepth(depth, s);
+  depth = erodeDepth(depth, s, noise);
+  for (int pass = 0; pass < s.smooth_passes; ++pass) depth = smoothDepth(depth, s, noise);
   return depth;
 }
 

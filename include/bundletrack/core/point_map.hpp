@@ -3,6 +3,7 @@
 #include <opencv2/core.hpp>
 
 #include "bundletrack/core/camera.hpp"
+#include "bundletrack/core/depth_noise.hpp"
 
 namespace bundletrack {
 
@@ -24,8 +25,9 @@ inline cv::Mat unprojectDepth(const cv::Mat& depth, const PinholeCameraf& camera
 
 /// Unit normals from the cross product of central differences of the point map, facing the
 /// camera (n . p < 0). A normal is undefined (zero) where a neighbour is invalid or lies more than
-/// max_depth_jump (metres) from the centre in depth, i.e. across a depth discontinuity.
-inline cv::Mat estimateNormals(const cv::Mat& points, float max_depth_jump = 0.02f) {
+/// max_depth_jump (metres, widened by `noise` at the centre's depth) from the centre in depth, i.e.
+/// across a depth discontinuity.
+inline cv::Mat estimateNormals(const cv::Mat& points, float max_depth_jump = 0.02f, const NoiseScale& noise = NoiseScale()) {
   CV_Assert(points.type() == CV_32FC3);
   cv::Mat normals(points.size(), CV_32FC3, cv::Scalar::all(0));
   normals.forEach<cv::Vec3f>([&](cv::Vec3f& n, const int* pos) {
@@ -36,8 +38,9 @@ inline cv::Mat estimateNormals(const cv::Mat& points, float max_depth_jump = 0.0
     const cv::Vec3f& right = points.at<cv::Vec3f>(v, u + 1);
     const cv::Vec3f& up = points.at<cv::Vec3f>(v - 1, u);
     const cv::Vec3f& down = points.at<cv::Vec3f>(v + 1, u);
+    const float jump = noise.widen(max_depth_jump, c[2]);
     for (const cv::Vec3f* q : {&c, &left, &right, &up, &down})
-      if ((*q)[2] <= 0.0f || std::abs((*q)[2] - c[2]) > max_depth_jump) return;
+      if ((*q)[2] <= 0.0f || std::abs((*q)[2] - c[2]) > jump) return;
     cv::Vec3f cross = (right - left).cross(down - up);
     const float length = float(cv::norm(cross));
     if (length <= 0.0f) return;

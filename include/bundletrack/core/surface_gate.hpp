@@ -1,6 +1,7 @@
 #pragma once
 
 #include "bundletrack/core/angles.hpp"
+#include "bundletrack/core/depth_noise.hpp"
 
 namespace bundletrack {
 
@@ -20,6 +21,10 @@ struct SurfaceGate {
       return squared_distance <= max_squared_distance && cos_angle >= cos_max_angle;
     }
   };
+
+  /// The gate between readings `scale` times noisier than the reference ones (NoiseScale): the
+  /// distance widened, the angle kept.
+  SurfaceGate widened(double scale) const { return {float(max_distance * scale), max_normal_angle_deg}; }
 
   template <typename T>
   Bounds<T> bounds() const {

@@ -25,6 +25,8 @@ struct SurfaceGrid {
   cv::Mat normals;  ///< CV_32FC3
   std::vector<cv::Point> cells;  ///< grid cells with a point, row by row
   PinholeCameraf camera{};
+  double noise_scale = 1.0;  ///< the sensor's NoiseScale at the points' median depth
+
 
   bool inside(int u, int v) const { return u >= 0 && v >= 0 && u < points.cols && v < points.rows; }
 };
@@ -46,6 +48,9 @@ inline SurfaceGrid sampleSurface(const RgbdFrame& frame, const cv::Mat& mask, co
       if (use) grid.cells.emplace_back(x, y);
     }
   }
+  std::vector<float> depths;
+  for (const cv::Point& cell : grid.cells) depths.push_back(grid.points.at<cv::Vec3f>(cell)[2]);
+  grid.noise_scale = frame.noise.atMedian(std::move(depths));
   return grid;
 }
 

@@ -17,6 +17,9 @@ struct FrameFeatures {
   std::vector<Eigen::Vector3f> normals;
   cv::Mat descriptors;  ///< one row per keypoint
   int norm_type = cv::NORM_L2;  ///< distance between descriptors: NORM_L2 (SIFT) or NORM_HAMMING (ORB, AKAZE)
+  /// The sensor's NoiseScale at the points' median depth: what distance tolerances between these
+  /// points and another frame's are widened by (NoiseScale::between).
+  double noise_scale = 1.0;
 
   std::size_t size() const { return points.size(); }
 };

@@ -12,7 +12,8 @@
 namespace bundletrack {
 
 /// Unit normal at pixel (u, v) from a plane fit (smallest eigenvector of the covariance) to the
-/// valid points of the (2r+1)^2 window within max_depth_jump of the centre in depth; faces the
+/// valid points of the (2r+1)^2 window within max_depth_jump (already widened for the sensor's
+/// noise) of the centre in depth; faces the
 /// camera. Keypoints often sit where the per-pixel normal is undefined (texture edges coincide
 /// with depth noise), and the fit is also less noisy. Returns zero when fewer than 6 points fit.
 inline Eigen::Vector3f fitNormal(const cv::Mat& points, int u, int v, int r, float max_depth_jump) {
@@ -39,7 +40,8 @@ inline Eigen::Vector3f fitNormal(const cv::Mat& points, int u, int v, int r, flo
 }
 
 /// Lifts full-resolution keypoints to 3-D with the frame's depth; keypoints without a valid depth
-/// reading or normal are dropped together with their descriptor row.
+/// reading or normal are dropped together with their descriptor row. max_depth_jump is widened by
+/// the frame's noise at each keypoint's depth.
 inline FrameFeatures liftKeypoints(const RgbdFrame& frame, const std::vector<cv::Point2f>& pixels,
                                    const cv::Mat& descriptors, int norm_type, int normal_radius = 3,
                                    float max_depth_jump = 0.02f) {
@@ -51,7 +53,7 @@ inline FrameFeatures liftKeypoints(const RgbdFrame& frame, const std::vector<cv:
     if (u < 0 || v < 0 || u >= frame.depth.cols || v >= frame.depth.rows) continue;
     const cv::Vec3f& p = frame.points.at<cv::Vec3f>(v, u);
     if (p[2] <= 0.0f) continue;
-    const Eigen::Vector3f n = fitNormal(frame.points, u, v, normal_radius, max_depth_jump);
+    const Eigen::Vector3f n = fitNormal(frame.points, u, v, normal_radius, frame.noise.widen(max_depth_jump, p[2]));
     if (n.isZero()) continue;
     features.pixels.push_back(pixels[k]);
     features.points.emplace_back(p[0], p[1], p[2]);
@@ -60,6 +62,9 @@ inline FrameFeatures liftKeypoints(const RgbdFrame& frame, const std::vector<cv:
   }
   features.descriptors.create(int(kept.size()), descriptors.cols, descriptors.type());
   for (std::size_t i = 0; i < kept.size(); ++i) descriptors.row(kept[i]).copyTo(features.descriptors.row(int(i)));
+  std::vector<float> depths;
+  for (const Eigen::Vector3f& p : features.points) depths.push_back(p.z());
+  features.noise_scale = frame.noise.atMedian(std::move(depths));
   return features;
 }
 

@@ -7,6 +7,8 @@
 #include <Eigen/Core>
 #include <opencv2/core.hpp>
 
+#include "bundletrack/core/depth_noise.hpp"
+
 namespace bundletrack {
 
 /// One surface of the depth image: pixels joined by depth-continuous 4-neighbour steps.
@@ -17,37 +19,34 @@ struct DepthSegment {
   float diagonal() const { return pixels > 0 ? (high - low).norm() : 0.0f; }
 };
 
-/// Largest depth step between neighbouring pixels of one surface at depth z: `continuity` metres
-/// up to 1 m, growing with z^2 beyond, as the depth resolution of structured-light and stereo
-/// sensors does (Kinect v1: ~3 mm steps at 1 m, ~13 mm at 2 m).
-inline float continuityAt(float z, float continuity) { return continuity * std::max(1.0f, z * z); }
-
 /// Grows a region from the pixels in `frontier` over 4-neighbours whose depth differs by at most
-/// continuityAt(depth, continuity) from the pixel they are reached from: claim(q) decides whether
-/// neighbour q joins (and marks it), reached(p) sees every pixel of the region once.
+/// `continuity` (widened by `noise` at the depth of the pixel they are reached from: the depth
+/// steps of one slanted surface grow with the sensor's noise and quantisation) from that pixel:
+/// claim(q) decides whether neighbour q joins (and marks it), reached(p) sees every pixel of the
+/// region once.
 template <typename Claim, typename Reached>
-void growOverContinuousDepth(const cv::Mat& depth, float continuity, std::vector<cv::Point>& frontier, Claim&& claim,
-                             Reached&& reached) {
+void growOverContinuousDepth(const cv::Mat& depth, float continuity, const NoiseScale& noise,
+                             std::vector<cv::Point>& frontier, Claim&& claim, Reached&& reached) {
   while (!frontier.empty()) {
     const cv::Point p = frontier.back();
     frontier.pop_back();
     reached(p);
-    const float z = depth.at<float>(p);
+    const float z = depth.at<float>(p), step_limit = noise.widen(continuity, z);
     for (const cv::Point step : {cv::Point(1, 0), cv::Point(-1, 0), cv::Point(0, 1), cv::Point(0, -1)}) {
       const cv::Point q = p + step;
       if (q.x < 0 || q.y < 0 || q.x >= depth.cols || q.y >= depth.rows) continue;
       const float zq = depth.at<float>(q);
-      if (zq <= 0.0f || std::abs(zq - z) > continuityAt(z, continuity) || !claim(q)) continue;
+      if (zq <= 0.0f || std::abs(zq - z) > step_limit || !claim(q)) continue;
       frontier.push_back(q);
     }
   }
 }
 
 /// Splits the valid depth into surfaces that neighbouring pixels join when their depths differ by
-/// at most continuityAt(depth, continuity). `labels` (CV_32SC1) gets each pixel's segment index, -1 where
+/// at most `continuity` widened by `noise` (growOverContinuousDepth). `labels` (CV_32SC1) gets each pixel's segment index, -1 where
 /// depth is invalid; returns the segments with their sizes and 3-D bounding boxes.
 inline std::vector<DepthSegment> segmentDepth(const cv::Mat& depth, const cv::Mat& points, float continuity,
-                                              cv::Mat& labels) {
+                                              const NoiseScale& noise, cv::Mat& labels) {
   labels.create(depth.size(), CV_32SC1);
   labels.setTo(-1);
   std::vector<DepthSegment> segments;
@@ -60,7 +59,7 @@ inline std::vector<DepthSegment> segmentDepth(const cv::Mat& depth, const cv::Ma
       labels.at<int>(v, u) = id;
       frontier.assign(1, {u, v});
       growOverContinuousDepth(
-          depth, continuity, frontier,
+          depth, continuity, noise, frontier,
           [&](const cv::Point& q) {
             if (labels.at<int>(q) >= 0) return false;
             labels.at<int>(q) = id;

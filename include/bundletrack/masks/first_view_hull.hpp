@@ -16,14 +16,16 @@ namespace bundletrack {
 /// mask (dilated for pose and calibration error) and lies behind the surface the first frame saw
 /// there, by no more than the object's visible extent (its bounding-box diagonal in that frame):
 /// a one-view visual hull, cut at the depth an object as deep as it is wide would reach.
-/// A part hidden by an occluder in the first frame lies outside the hull.
+/// A part hidden by an occluder in the first frame lies outside the hull. The depth tolerance in
+/// front of that surface is widened by the first frame's NoiseScale at the depth seen.
 class FirstViewHull {
  public:
   FirstViewHull() = default;
 
   FirstViewHull(const RgbdFrame& first, const PinholeCameraf& camera, const SE3d& T_cam_obj, int dilation_px,
                 float depth_tolerance)
-      : camera_(camera), T_cam_obj_(T_cam_obj), depth_(first.depth), depth_tolerance_(depth_tolerance) {
+      : camera_(camera), T_cam_obj_(T_cam_obj), depth_(first.depth), noise_(first.noise),
+        depth_tolerance_(depth_tolerance) {
     cv::dilate(first.mask, mask_, cv::getStructuringElement(cv::MORPH_ELLIPSE, {2 * dilation_px + 1, 2 * dilation_px + 1}));
     Eigen::Array3f low = Eigen::Array3f::Constant(INFINITY), high = -low;
     for (int v = 0; v < first.mask.rows; ++v) {
@@ -45,13 +47,14 @@ class FirstViewHull {
     if (!camera_.pixelOf(p, u, v)) return false;
     if (u < 0 || v < 0 || u >= mask_.cols || v >= mask_.rows || !mask_.at<uchar>(v, u)) return false;
     const float seen = depth_.at<float>(v, u);
-    return seen <= 0.0f || (p.z() >= seen - depth_tolerance_ && p.z() <= seen + extent_);
+    return seen <= 0.0f || (p.z() >= seen - noise_.widen(depth_tolerance_, seen) && p.z() <= seen + extent_);
   }
 
  private:
   PinholeCameraf camera_{};
   SE3d T_cam_obj_;
   cv::Mat mask_, depth_;
+  NoiseScale noise_;
   float depth_tolerance_ = 0.0f;
   float extent_ = 0.0f;
 };

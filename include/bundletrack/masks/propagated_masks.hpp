@@ -23,11 +23,11 @@ struct PropagatedMaskSettings {
   /// comes into view.
   int growth_px = 8;
   /// Observed depth within this of the rendered object depth seeds the mask: a few mm of coarse
-  /// pose error plus 3 sigma of Kinect noise at 1.5 m (5 mm) plus grazing-angle spread.
+  /// pose error plus 3 sigma of Kinect noise at 1.5 m (5 mm) plus grazing-angle spread. Like the
+  /// two depth tolerances below, widened by the frame's NoiseScale at the pixel's depth.
   float depth_agreement = 0.02f;
-  /// Neighbouring pixels of one surface differ by less than this in depth up to 1 m, growing with
-  /// z^2 beyond (continuityAt): 1 px is ~2 mm at 1 m, a 60 degree slant triples that, and objects
-  /// stand out from their background by more.
+  /// Neighbouring pixels of one surface differ by less than this in depth: 1 px is ~2 mm at 1 m, a
+  /// 60 degree slant triples that, and objects stand out from their background by more.
   float depth_continuity = 0.01f;
   int hull_dilation_px = 5;  ///< pose and depth/colour registration error (1-3 px) of the first view
   float hull_depth_tolerance = 0.015f;  ///< metres in front of the first view's surface still inside
@@ -96,14 +96,14 @@ class PropagatedMasks {
         const cv::Vec3f& p = frame.points.at<cv::Vec3f>(v, u);
         if (!hull_.contains(T_obj_cam * Eigen::Vector3d(p[0], p[1], p[2]))) continue;
         const float expected = rendered.at<float>(v, u);
-        const bool agrees = expected > 0.0f && std::abs(z - expected) <= settings_.depth_agreement;
+        const bool agrees = expected > 0.0f && std::abs(z - expected) <= frame.noise.widen(settings_.depth_agreement, z);
         label.at<uchar>(v, u) = agrees ? kObject : kCandidate;
         if (agrees) frontier.emplace_back(u, v);
       }
     }
     // Grow over depth-continuous candidates (candidates lie inside the box).
     growOverContinuousDepth(
-        frame.depth, settings_.depth_continuity, frontier,
+        frame.depth, settings_.depth_continuity, frame.noise, frontier,
         [&](const cv::Point& q) {
           if (label.at<uchar>(q) != kCandidate) return false;
           label.at<uchar>(q) = kObject;
@@ -123,7 +123,7 @@ class PropagatedMasks {
   /// the whole valid depth when there is none.
   cv::Mat objectSizedSurfaces(const RgbdFrame& frame) const {
     cv::Mat labels;
-    const std::vector<DepthSegment> segments = segmentDepth(frame.depth, frame.points, settings_.depth_continuity, labels);
+    const std::vector<DepthSegment> segments = segmentDepth(frame.depth, frame.points, settings_.depth_continuity, frame.noise, labels);
     std::vector<uchar> keep(segments.size());
     bool any = false;
     for (std::size_t k = 0; k < segments.size(); ++k) {

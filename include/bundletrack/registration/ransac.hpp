@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "bundletrack/core/angles.hpp"
+#include "bundletrack/core/depth_noise.hpp"
 #include "bundletrack/core/execution.hpp"
 #include "bundletrack/features/frame_features.hpp"
 #include "bundletrack/registration/feature_registration.hpp"
@@ -52,14 +53,14 @@ struct MatchedPoints {
   std::pair<const Eigen::Vector3f&, const Eigen::Vector3f&> pair(std::size_t k) const { return {first[k], second[k]}; }
 };
 
-/// Paper IV-B's inlier test: the moved point within inlier_distance and the moved normal within
-/// inlier_normal_angle_deg of its match.
+/// Paper IV-B's inlier test: the moved point within inlier_distance (widened by the two frames'
+/// noise, NoiseScale::between) and the moved normal within inlier_normal_angle_deg of its match.
 struct InlierGate {
   float max_squared_distance;
   float cos_max_angle;
 
-  explicit InlierGate(const RansacSettings& s)
-      : max_squared_distance(s.inlier_distance * s.inlier_distance),
+  InlierGate(const RansacSettings& s, double noise_scale)
+      : max_squared_distance(float(s.inlier_distance * noise_scale * s.inlier_distance * noise_scale)),
         cos_max_angle(cosOfDegrees<float>(s.inlier_normal_angle_deg)) {}
 
   bool admits(const MatchedPoints& pairs, std::size_t k, const SE3f& T, const Eigen::Matrix3f& R) const {
@@ -119,7 +120,7 @@ class CpuTrialScorer {
 };
 
 /// RANSAC over 3-D feature matches (paper IV-B): 3-point samples, closed-form fit (kabsch), a match
-/// is an inlier when the moved point lies within inlier_distance AND the moved normal within
+/// is an inlier when the moved point lies within inlier_distance (widened for the sensor's noise) AND the moved normal within
 /// inlier_normal_angle_deg. The trial count adapts to the best inlier ratio w found so far,
 /// N = log(1 - confidence) / log(1 - w^3), capped at max_trials; ties go to the earliest trial, so
 /// the result is deterministic whatever counts the inliers. The winner is refitted on its inliers
@@ -137,7 +138,7 @@ class BasicRansac {
     result.matches = matches.size();
     if (matches.size() < 3) return result;
     const MatchedPoints pairs(first, second, matches);
-    const InlierGate gate(settings_);
+    const InlierGate gate(settings_, NoiseScale::between(first.noise_scale, second.noise_scale));
     scorer_.prepare(pairs);
     const int n = int(matches.size());
     std::vector<SE3d> fits;

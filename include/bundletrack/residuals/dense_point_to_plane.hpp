@@ -9,7 +9,8 @@ namespace bundletrack {
 
 /// Paper eq. 3: dense point-to-plane distances by projective association on the surface grids.
 /// A point p_s of grid s is moved into frame t (T_t T_s^-1 p_s), projected with t's grid camera,
-/// and paired with the point p_t seen at that cell; the pair counts when it passes `gate`. The
+/// and paired with the point p_t seen at that cell; the pair counts when it passes `gate`, widened
+/// for the two grids' noise (NoiseScale::between). The
 /// residual, in the object frame with m = R_s^T n_s,
 ///   r = m . (T_t^-1 p_t - T_s^-1 p_s),
 /// has dr/dd_s = [m^T, (b x m)^T] with b = T_t^-1 p_t, and dr/dd_t = -dr/dd_s (it depends on the
@@ -40,7 +41,7 @@ struct DensePointToPlane {
     const Eigen::Isometry3d T_s_inv = affine(T_s.inverse()), T_t_inv = affine(T_t.inverse());
     const Eigen::Isometry3d T_t_s = affine(T_t * T_s.inverse()), T_s_t = affine(T_s * T_t.inverse());
     const Eigen::Matrix3d R_s_inv = T_s_inv.linear(), R_s_t = T_s_t.linear();
-    const SurfaceGate::Bounds<double> bounds = gate.bounds<double>();
+    const SurfaceGate::Bounds<double> bounds = gate.widened(NoiseScale::between(s.noise_scale, t.noise_scale)).bounds<double>();
     for (const cv::Point& cell : s.cells) {
       const cv::Vec3f& ps = s.points.at<cv::Vec3f>(cell);
       const Eigen::Vector3d p_s(ps[0], ps[1], ps[2]);

@@ -22,7 +22,7 @@ struct SurfaceAgreementSettings {
 
 /// Verification by surface agreement: of the current frame's grid points that land on a valid
 /// point of another node (projective association under the optimised poses), the fraction that
-/// passes the gate. Grids have holes (depth dropouts, undefined normals), so points landing in a
+/// passes the gate, widened for the two grids' noise (NoiseScale::between). Grids have holes (depth dropouts, undefined normals), so points landing in a
 /// hole say nothing; when fewer than a quarter of the points land anywhere the agreement is 0.
 class SurfaceAgreement {
  public:
@@ -37,9 +37,13 @@ class SurfaceAgreement {
 
   double agreement(const PoseGraph& graph) const {
     const SurfaceGrid& current = graph.nodes.back()->surface;
-    const SurfaceGate::Bounds<double> bounds = settings_.gate.bounds<double>();
     std::vector<SE3d> T_k_c;
-    for (std::size_t k = 0; k + 1 < graph.nodes.size(); ++k) T_k_c.push_back(graph.poses[k] * graph.poses.back().inverse());
+    std::vector<SurfaceGate::Bounds<double>> bounds;  // per node: the gate widened for the pair's noise
+    for (std::size_t k = 0; k + 1 < graph.nodes.size(); ++k) {
+      T_k_c.push_back(graph.poses[k] * graph.poses.back().inverse());
+      const double scale = NoiseScale::between(current.noise_scale, graph.nodes[k]->surface.noise_scale);
+      bounds.push_back(settings_.gate.widened(scale).bounds<double>());
+    }
     int valid = 0, compared = 0, agreeing = 0;
     for (int y = 0; y < current.points.rows; ++y) {
       for (int x = 0; x < current.points.cols; ++x) {
@@ -57,10 +61,10 @@ class SurfaceAgreement {
           const cv::Vec3f& pk = other.points.at<cv::Vec3f>(v, u);
           if (pk[2] <= 0.0f) continue;
           landed = true;
-          if ((Eigen::Vector3d(pk[0], pk[1], pk[2]) - q).squaredNorm() > bounds.max_squared_distance) continue;
+          if ((Eigen::Vector3d(pk[0], pk[1], pk[2]) - q).squaredNorm() > bounds[k].max_squared_distance) continue;
           const cv::Vec3f& nk = other.normals.at<cv::Vec3f>(v, u);
           const Eigen::Vector3d n = T_k_c[k].rotation() * Eigen::Vector3d(nc[0], nc[1], nc[2]);
-          agrees = n.dot(Eigen::Vector3d(nk[0], nk[1], nk[2])) >= bounds.cos_max_angle;
+          agrees = n.dot(Eigen::Vector3d(nk[0], nk[1], nk[2])) >= bounds[k].cos_max_angle;
         }
         compared += landed;
         agreeing += agrees;

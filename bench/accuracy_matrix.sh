@@ -1,0 +1,135 @@
+#!/usr/bin/env bash
+# The stress matrix (issue 15): synthetic sequences with exact ground truth over distance, object,
+# texture, speed and sensor, plus the shared real sequences where present, tracked with the
+# default settings. Per cell: ADD, ADD-S, mean rotation error, lost frames (all, and those while
+# the object is in view), median tracking time. With --before, a second build's tracker runs on
+# the very same sequences and its columns stand beside.
+#
+# The design is sparse (41 synthetic cells, not the 144 of the full product), chosen so that each
+# factor varies with the others held at their usual value:
+#   A  distance {0.5, 1, 2, 3 m} x object {mug 0.10 m, box 0.20 m, chair 0.70 m} x {textured,
+#      textureless}, structured light, normal speed (no chair at 0.5 m: it would not fit the view);
+#   B  sensor {active stereo, time of flight} x distance {1, 3 m} x object, textured;
+#   C  fast motion (3x) x {box, mug} x {1, 2 m}, textured;
+#   D  an occluder (box, 1 m) and the object carried out of view and back (box at 1 m; textureless
+#      chair at 2.5 m).
+#
+# Usage: bash bench/accuracy_matrix.sh BUILD_DIR OUT_DIR [--before BUILD_DIR] [--data DIR]
+#        [--frames N] [--markdown FILE]
+# (BUILD_DIR: a build tree or a folder holding bundletrack_track.) Sequences are generated once
+# into OUT_DIR/sequences; the --before runs are kept in OUT_DIR/runs/before and reused.
+# Writes OUT_DIR/matrix.csv and the Markdown table (default OUT_DIR/ACCURACY.md; the committed
+# bench/ACCURACY.md is made with --markdown bench/ACCURACY.md).
+set -euo pipefail
+build=${1:?build directory}
+out=${2:?output directory}
+shift 2
+before="" data="$(dirname "$0")/../../shared/data/7scenes_objects" frames=100 markdown=""
+while [ $# -gt 0 ]; do
+  case "$1" in
+    --before) before=$2; shift 2 ;;
+    --data) data=$2; shift 2 ;;
+    --frames) frames=$2; shift 2 ;;
+    --markdown) markdown=$2; shift 2 ;;
+    *) echo "unknown option $1" >&2; exit 2 ;;
+  esac
+done
+markdown=${markdown:-$out/ACCURACY.md}
+mkdir -p "$out/sequences"
+py=/usr/bin/python3
+
+cells=()
+size_of() { case $1 in mug) echo 0.10 ;; box) echo 0.20 ;; chair) echo 0.70 ;; esac; }
+for d in 0.5 1 2 3; do
+  for o in mug box chair; do
+    [ "$o" = chair ] && [ "$d" = 0.5 ] && continue
+    for t in textured textureless; do
+      opts="--shape $o --size $(size_of $o) --distance $d"
+      [ "$t" = textureless ] && opts+=" --textureless"
+      cells+=("A_${o}_${d}m_${t}|$opts")
+    done
+  done
+done
+for s in active_stereo time_of_flight; do
+  for d in 1 3; do
+    for o in mug box chair; do cells+=("B_${o}_${d}m_${s}|--shape $o --size $(size_of $o) --distance $d --sensor $s"); done
+  done
+done
+for o in box mug; do
+  for d in 1 2; do cells+=("C_${o}_${d}m_fast|--shape $o --size $(size_of $o) --distance $d --speed 3"); done
+done
+cells+=("D_box_1m_occluder|--shape box --distance 1 --occluder")
+cells+=("D_box_1m_out_of_view|--shape box --distance 1 --out-of-view 40 15")
+cells+=("D_chair_2.5m_textureless_out_of_view|--shape chair --size 0.70 --distance 2.5 --textureless --out-of-view 40 15")
+
+track() {  # build sequence target [reuse] -> csv fields
+  local bin=$1/bin/bundletrack_track seq=$2 target=$3 reuse=${4:-}
+  [ -x "$bin" ] || bin=$1/bundletrack_track
+  mkdir -p "$target"
+  if [ -z "$reuse" ] || ! grep -q "^sequence" "$target.log" 2> /dev/null; then
+    "$bin" --sequence "$seq" --out "$target" --quiet > "$target.log" 2>&1 || { echo "n/a,n/a,n/a,n/a,n/a,n/a"; return; }
+  fi
+  $py - "$seq" "$target" <<'PY'
+import csv, pathlib, sys
+import cv2
+seq, target = pathlib.Path(sys.argv[1]), pathlib.Path(sys.argv[2])
+log = (target.parent / (target.name + ".log")).read_text().splitlines()
+header = next(i for i, line in enumerate(log) if line.startswith("sequence"))
+fields = log[header + 1].split()
+add, adds, r_err = fields[1], fields[2], fields[5].replace("dg", "")
+rows = list(csv.DictReader(open(target / "track.csv")))
+lost = [r for r in rows if r["status"] == "lost"]
+def in_view(frame):
+    mask = seq / "masks" / (frame + ".png")
+    return mask.exists() and cv2.countNonZero(cv2.imread(str(mask), cv2.IMREAD_GRAYSCALE)) > 0
+lost_in_view = sum(in_view(r["frame"]) for r in lost)
+times = sorted(float(r["total_ms"]) for r in rows[1:])
+print(f"{add},{adds},{r_err},{len(lost)},{lost_in_view},{times[len(times) // 2]:.1f}")
+PY
+}
+
+csv_file="$out/matrix.csv"
+echo "cell,options,ADD,ADD-S,R_err_deg,lost,lost_in_view,ms_per_frame,before_ADD,before_ADD-S,before_R_err_deg,before_lost,before_lost_in_view,before_ms_per_frame" > "$csv_file"
+run_cell() {  # name options sequence
+  local name=$1 options=$2 seq=$3 after before_fields=",,,,,"
+  after=$(track "$build" "$seq" "$out/runs/after/$name")
+  [ -n "$before" ] && before_fields=$(track "$before" "$seq" "$out/runs/before/$name" reuse)
+  echo "$name,\"$options\",$after,$before_fields" >> "$csv_file"
+  echo "$name: $after | before: $before_fields"
+}
+for cell in "${cells[@]}"; do
+  name=${cell%%|*}
+  options=${cell#*|}
+  seq="$out/sequences/$name"
+  # shellcheck disable=SC2086
+  [ -d "$seq/rgb" ] || "$build/bin/bundletrack_synth" --out "$seq" --frames "$frames" $options > /dev/null
+  run_cell "$name" "$options" "$seq"
+done
+for s in mug_1 magazines_1 container_1; do
+  [ -d "$data/$s" ] && run_cell "real_$s" "shared sequence" "$data/$s"
+done
+
+$py - "$csv_file" "$markdown" "$frames" "$([ -n "$before" ] && echo 1 || echo 0)" <<'PY'
+import csv, sys
+rows = list(csv.DictReader(open(sys.argv[1])))
+frames, with_before = sys.argv[3], sys.argv[4] == "1"
+out = ["# Accuracy stress matrix", "",
+       f"Generated by `bash bench/accuracy_matrix.sh` (synthetic cells: {frames} frames each, exact ground truth;",
+       "default settings). ADD and ADD-S: AUC in % (0-10 cm); R_err: mean rotation error in degrees;",
+       "lost: frames reported lost (in view: while the object's true mask is not empty); ms: median",
+       "tracking time per frame on this machine (2 cores). Cell names: A distance x object x texture,",
+       "B sensor, C fast motion, D occlusion and out of view; see the script's header for the design.", ""]
+head = "| cell | options | ADD | ADD-S | R_err | lost (in view) | ms |"
+rule = "|---|---|---|---|---|---|---|"
+if with_before:
+    head += " before: ADD | ADD-S | R_err | lost (in view) | ms |"
+    rule += "---|---|---|---|---|"
+out += [head, rule]
+for r in rows:
+    line = f"| {r['cell']} | {r['options']} | {r['ADD']} | {r['ADD-S']} | {r['R_err_deg']} | {r['lost']} ({r['lost_in_view']}) | {r['ms_per_frame']} |"
+    if with_before:
+        line += f" {r['before_ADD']} | {r['before_ADD-S']} | {r['before_R_err_deg']} | {r['before_lost']} ({r['before_lost_in_view']}) | {r['before_ms_per_frame']} |"
+    out.append(line)
+open(sys.argv[2], "w").write("\n".join(out) + "\n")
+PY
+echo "wrote $csv_file and $markdown"
