@@ -149,7 +149,7 @@ TEST_CASE("a textureless mug hidden by a passing arm is re-acquired by its surfa
   const auto model = scene.objectMesh().sampleSurface(1000, 1);
   const Run surface = track(bt::DefaultTracker(camera), scene, model);
   bt::TrackerSettings features_only;
-  features_only.recovery_min_keypoints = 0;  // re-acquisition by features alone, as before
+  features_only.recovery_surface_candidates = 0;  // re-acquisition by features alone, as before
   const Run stuck = track(bt::DefaultTracker(camera, features_only), scene, model);
   MESSAGE("lost frames: " << surface.lost << " (features only: " << stuck.lost << "), ADD-S " << surface.score.adds_auc
                           << " (features only: " << stuck.score.adds_auc << ")");

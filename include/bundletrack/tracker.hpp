@@ -49,7 +49,9 @@ class Tracker {
     clock_.start(&StageTimings::mask);
     TrackResult result;
     RgbdFrame masked = frame;  // shares the image buffers
-    masked.mask = result.mask = masks_.start(frame, camera_, T_cam_obj, settings_.dense_grid_step);
+    grid_step_ = frame.mask.empty() ? settings_.dense_grid_step
+                                    : gridStepFor(frame, frame.mask, settings_.dense_target_samples, settings_.dense_grid_step);
+    masked.mask = result.mask = masks_.start(frame, camera_, T_cam_obj, grid_step_);
     clock_.enter(&StageTimings::features);
     FrameFeatures features = correspondences_.detect(masked);
     clock_.enter(&StageTimings::graph);
@@ -57,7 +59,7 @@ class Tracker {
     cache_.clear();
     frame_index_ = 0;
     lost_streak_ = 0;
-    pool_.add(makeKeyframe(0, masked, masked.mask, features, T_cam_obj, camera_, settings_.dense_grid_step));
+    pool_.add(makeKeyframe(0, masked, masked.mask, features, T_cam_obj, camera_, grid_step_));
     last_ = LastGood{0, T_cam_obj, std::move(features), pool_[0].surface};
     result.T_cam_obj = T_cam_obj;
     result.status = TrackStatus::Tracked;
@@ -74,10 +76,7 @@ class Tracker {
     if (!searchObject(ctx)) return lost(ctx);  // the object is out of sight
     detectKeypoints(ctx);
     if (!estimateCoarsePose(ctx)) return lost(ctx);
-    if (!segmentObject(ctx)) return lost(ctx);  // not where the coarse pose says
-    buildGraph(ctx);
-    optimiseGraph(ctx);
-    if (!acceptPose(ctx)) return lost(ctx);
+    if (!refineCoarsePose(ctx)) return lost(ctx);
     cutMaskWithFinalPose(ctx);
     admitKeyframe(ctx);
     ctx.result.timings = clock_.stop();
@@ -132,29 +131,105 @@ class Tracker {
     return pair;
   }
 
-  /// Paper IV-B: RANSAC with the last good frame. After lost frames the object may come back
-  /// anywhere, a geometric check alone accepts symmetric wrong poses (a box turned by 90 degrees)
-  /// and a few inliers happen by chance; so the track restarts only from recovery_min_inliers
-  /// inliers, with the last good frame or else with a keyframe, or, for a frame too poor in
-  /// texture ever to gather them, from the last good pose with the surface alone to confirm it.
+  /// Paper IV-B: RANSAC with the last good frame; after lost frames, the candidates of
+  /// reacquisitionCandidates.
   bool estimateCoarsePose(FrameContext& ctx) {
     PairRegistration from_last = registerPair(last_->features, ctx.features, std::nullopt);
     ctx.result.matches = int(from_last.matches.size());
     ctx.result.inliers = int(from_last.inliers.size());
-    CoarseEstimate& coarse = ctx.coarse;
-    coarse.from_last = ctx.result.inliers >= (ctx.recovering ? settings_.recovery_min_inliers : settings_.min_inliers);
-    coarse.found = coarse.from_last;
+    if (ctx.recovering) return reacquisitionCandidates(ctx, std::move(from_last));
+    CoarseEstimate coarse;
+    coarse.found = coarse.from_last = ctx.result.inliers >= settings_.min_inliers;
     coarse.T_cam_obj = coarse.found ? from_last.T_second_first * last_->T_cam_obj : last_->T_cam_obj;
-    if (coarse.from_last) coarse.last_inliers = std::move(from_last.inliers);
-    if (!ctx.recovering || coarse.found) return true;
-    const auto relocalised = relocalise(pool_, last_->T_cam_obj.rotation(), settings_.max_keyframes,
-                                        settings_.recovery_min_inliers, [&](const Keyframe& keyframe) {
-                                          return registerPair(keyframe.features, ctx.features, std::nullopt);
-                                        });
-    coarse.found = relocalised.has_value();
-    coarse.T_cam_obj = relocalised.value_or(coarse.T_cam_obj);
-    coarse.by_surface = !coarse.found && int(ctx.features.size()) < settings_.recovery_min_keypoints;
-    return coarse.found || coarse.by_surface;
+    if (coarse.found) coarse.last_inliers = std::move(from_last.inliers);
+    ctx.candidates.push_back(std::move(coarse));
+    return true;
+  }
+
+  /// After lost frames the object may come back anywhere, a geometric check alone accepts
+  /// symmetric wrong poses (a box turned by 90 degrees) and a few inliers happen by chance. So a
+  /// registration with recovery_min_inliers inliers -- with the last good frame, or else with a
+  /// keyframe -- is tried on its features' evidence; the other candidates (at most
+  /// recovery_surface_candidates: registrations with min_inliers or more, the last good pose,
+  /// and that pose moved onto the object's points now) must pass the verifier's test for a pose
+  /// with the surface alone behind it.
+  bool reacquisitionCandidates(FrameContext& ctx, PairRegistration from_last) {
+    std::vector<CoarseEstimate> by_surface;
+    const auto add = [&](const SE3d& T_cam_obj, int inliers, bool is_last) {
+      CoarseEstimate coarse{T_cam_obj, true, is_last, Evidence::Features, is_last ? from_last.inliers : std::vector<FeatureMatch>()};
+      if (inliers >= settings_.recovery_min_inliers && ctx.candidates.empty()) {
+        ctx.candidates.push_back(std::move(coarse));
+      } else {
+        coarse.evidence = Evidence::SurfaceOnly;
+        by_surface.push_back(std::move(coarse));
+      }
+    };
+    const SE3d from_last_pose = from_last.T_second_first * last_->T_cam_obj;
+    const int last_inliers = ctx.result.inliers;
+    if (last_inliers >= settings_.recovery_min_inliers) {
+      add(from_last_pose, last_inliers, true);
+    } else {
+      // The registration with the last good frame ranks among the keyframes' by its inliers.
+      bool last_added = last_inliers < settings_.min_inliers;
+      for (const RelocalisedPose& pose :
+           relocalise(pool_, last_->T_cam_obj.rotation(), settings_.max_keyframes, settings_.min_inliers,
+                      [&](const Keyframe& keyframe) { return registerPair(keyframe.features, ctx.features, std::nullopt); })) {
+        if (!last_added && last_inliers >= pose.inliers) {
+          add(from_last_pose, last_inliers, true);
+          last_added = true;
+        }
+        add(pose.T_cam_obj, pose.inliers, false);
+      }
+      if (!last_added) add(from_last_pose, last_inliers, true);
+    }
+    by_surface.push_back({last_->T_cam_obj, false, false, Evidence::SurfaceOnly, {}});
+    if (const std::optional<SE3d> moved = movedOntoObject(ctx.masked))
+      by_surface.push_back({*moved, false, false, Evidence::SurfaceOnly, {}});
+    by_surface.resize(std::min(by_surface.size(), std::size_t(std::max(0, settings_.recovery_surface_candidates))));
+    for (CoarseEstimate& coarse : by_surface) ctx.candidates.push_back(std::move(coarse));
+    return !ctx.candidates.empty();
+  }
+
+  /// A coarse geometric search: the last good pose translated by the offset between the centroid of
+  /// the last good frame's object points and that of the points in this frame's search region;
+  /// none when the region holds no points or is far larger than the object (it is not the object).
+  std::optional<SE3d> movedOntoObject(const RgbdFrame& masked) const {
+    const SurfaceGrid& seen = last_->surface;
+    if (seen.cells.empty()) return std::nullopt;
+    Eigen::Vector3d before = Eigen::Vector3d::Zero(), now = Eigen::Vector3d::Zero();
+    for (const cv::Point& cell : seen.cells) {
+      const cv::Vec3f& p = seen.points.at<cv::Vec3f>(cell);
+      before += Eigen::Vector3d(p[0], p[1], p[2]);
+    }
+    before /= double(seen.cells.size());
+    const int step = grid_step_;
+    int count = 0;
+    for (int v = 0; v < masked.mask.rows; v += step) {
+      for (int u = 0; u < masked.mask.cols; u += step) {
+        const cv::Vec3f& p = masked.points.at<cv::Vec3f>(v, u);
+        if (!masked.mask.at<uchar>(v, u) || p[2] <= 0.0f) continue;
+        now += Eigen::Vector3d(p[0], p[1], p[2]);
+        ++count;
+      }
+    }
+    if (count == 0 || count > 2 * int(seen.cells.size())) return std::nullopt;
+    now /= double(count);
+    return SE3d(SO3d(), now - before) * last_->T_cam_obj;
+  }
+
+  /// Paper IV-C to IV-E's checks on each coarse pose in turn (segment under it, build and optimise
+  /// the graph, verify); the first accepted result is the frame's.
+  bool refineCoarsePose(FrameContext& ctx) {
+    const FrameFeatures detected = ctx.candidates.size() > 1 ? ctx.features : FrameFeatures();
+    for (std::size_t k = 0; k < ctx.candidates.size(); ++k) {
+      if (k > 0) ctx.features = detected;
+      ctx.coarse = std::move(ctx.candidates[k]);
+      if (!segmentObject(ctx)) continue;  // not where the coarse pose says
+      buildGraph(ctx);
+      optimiseGraph(ctx);
+      if (acceptPose(ctx)) return true;
+    }
+    return false;
   }
 
   /// The object's mask under the coarse pose; keypoints off it are dropped.
@@ -174,7 +249,7 @@ class Tracker {
   void buildGraph(FrameContext& ctx) {
     clock_.enter(&StageTimings::graph);
     ctx.current = makeKeyframe(ctx.id, ctx.masked, ctx.masked.mask, std::move(ctx.features), ctx.coarse.T_cam_obj,
-                               camera_, settings_.dense_grid_step);
+                               camera_, grid_step_);
     const LastFrameLink last{last_->id, ctx.coarse.from_last ? &ctx.coarse.last_inliers : nullptr};
     ctx.graph = buildPoseGraph(pool_, settings_.max_keyframes, ctx.current, ctx.coarse.T_cam_obj, last, cache_,
                                [&](const Keyframe& a, const Keyframe& b, const SE3d& T_a, const SE3d& T_b) {
@@ -202,8 +277,7 @@ class Tracker {
   /// The graph's result when the verifier trusts it (the keyframes take their optimised poses
   /// too), else the coarse pose, unless there is none or the track is being re-acquired.
   bool acceptPose(FrameContext& ctx) {
-    const Evidence evidence = ctx.coarse.by_surface ? Evidence::SurfaceOnly : Evidence::Features;
-    if (verifier_.accepts(ctx.graph, evidence)) {
+    if (verifier_.accepts(ctx.graph, ctx.coarse.evidence)) {
       for (std::size_t n = 0; n < ctx.graph.pool_indices.size(); ++n)
         pool_[ctx.graph.pool_indices[n]].T_cam_obj = ctx.graph.poses[n];
       ctx.result.T_cam_obj = ctx.graph.poses.back();
@@ -225,7 +299,7 @@ class Tracker {
     ctx.masked.mask = ctx.result.mask = refined;
     keepFeaturesInside(ctx.current.features, refined);
     ctx.current = makeKeyframe(ctx.id, ctx.masked, refined, std::move(ctx.current.features), ctx.result.T_cam_obj,
-                               camera_, settings_.dense_grid_step);
+                               camera_, grid_step_);
   }
 
   /// Paper IV-E: the frame joins the pool when it shows a novel view (a copy only then: the graph
@@ -262,6 +336,7 @@ class Tracker {
   CorrespondenceCache cache_;
   std::optional<LastGood> last_;
   StageClock clock_;
+  int grid_step_ = 1;  ///< of every surface grid of this track (chosen at initialize)
   int frame_index_ = 0;
   int lost_streak_ = 0;  ///< frames lost since the last good one
 };

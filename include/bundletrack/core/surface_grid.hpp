@@ -1,5 +1,7 @@
 #pragma once
 
+#include <algorithm>
+#include <cmath>
 #include <vector>
 
 #include <opencv2/core.hpp>
@@ -30,6 +32,17 @@ struct SurfaceGrid {
 
   bool inside(int u, int v) const { return u >= 0 && v >= 0 && u < points.cols && v < points.rows; }
 };
+
+/// The grid step that samples about `target` of the points on `mask` with depth:
+/// floor(sqrt(points / target)), at least 1 and at most max_step. An object's grids then hold a
+/// similar number of points at any size and distance.
+inline int gridStepFor(const RgbdFrame& frame, const cv::Mat& mask, int target, int max_step) {
+  int points = 0;
+  for (int v = 0; v < mask.rows; ++v)
+    for (int u = 0; u < mask.cols; ++u) points += mask.at<uchar>(v, u) && frame.depth.at<float>(v, u) > 0.0f;
+  const int step = int(std::floor(std::sqrt(double(points) / double(std::max(1, target)))));
+  return std::clamp(step, 1, std::max(1, max_step));
+}
 
 /// Samples the masked surface of `frame` every `step` pixels.
 inline SurfaceGrid sampleSurface(const RgbdFrame& frame, const cv::Mat& mask, const PinholeCameraf& camera, int step) {

@@ -6,15 +6,16 @@
 #include "bundletrack/graph/pose_graph.hpp"
 #include "bundletrack/solvers/gauss_newton.hpp"
 #include "bundletrack/tracking/track_result.hpp"
+#include "bundletrack/verification/pose_verifier.hpp"
 
 namespace bundletrack {
 
-/// The coarse pose of a frame (paper IV-B) and where it came from.
+/// A coarse pose of a frame (paper IV-B) and what stands behind it.
 struct CoarseEstimate {
   SE3d T_cam_obj;  ///< the last good pose when nothing better was found
   bool found = false;  ///< from RANSAC, with the last good frame or a keyframe
   bool from_last = false;  ///< from RANSAC with the last good frame, whose inliers are below
-  bool by_surface = false;  ///< a texture-poor frame after lost frames: the surface alone must re-acquire it
+  Evidence evidence = Evidence::Features;  ///< SurfaceOnly: the verifier's stricter test decides
   std::vector<FeatureMatch> last_inliers;  ///< the matches with the last good frame that RANSAC kept
 };
 
@@ -28,7 +29,8 @@ struct FrameContext {
   bool recovering;  ///< the frames before were lost
   RgbdFrame masked;  ///< the frame with the mask the stages work on (shares the image buffers)
   FrameFeatures features;  ///< detected; moves into `current` when the graph is built
-  CoarseEstimate coarse;
+  std::vector<CoarseEstimate> candidates;  ///< coarse poses to try, in order (several only after lost frames)
+  CoarseEstimate coarse;  ///< the one being tried
   Keyframe current;  ///< the frame as a graph node
   PoseGraph graph;
   OptimizationReport optimisation;
