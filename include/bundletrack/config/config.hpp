@@ -110,7 +110,7 @@ inline std::vector<ConfigEntry> configEntries(Config& c) {
       {"depth", "min_depth", &depth.min_depth, 0.0, 100.0, "m", "closer readings are invalid"},
       {"depth", "max_depth", &depth.max_depth, 0.0, inf, "m", "farther readings are invalid"},
       {"depth", "erode_radius", &depth.erode_radius, 0, 10, "px", "erosion neighbourhood radius (1: 3x3)"},
-      {"depth", "erode_depth_diff", &depth.erode_depth_diff, 0.0, 1.0, "m", "a neighbour this far in depth counts against a pixel"},
+      {"depth", "erode_depth_diff", &depth.erode_depth_diff, 0.0, 1.0, "m", "a neighbour farther in depth than this and than 3 sigma of two readings' difference counts against a pixel"},
       {"depth", "erode_ratio", &depth.erode_ratio, 0.0, 1.0, "", "fraction of neighbours against a pixel that removes it"},
       {"depth", "smooth_radius", &depth.smooth_radius, 0, 10, "px", "smoothing window radius (2: 5x5)"},
       {"depth", "smooth_sigma", &depth.smooth_sigma, 1e-3, 100.0, "px", "spatial Gaussian of the smoothing"},

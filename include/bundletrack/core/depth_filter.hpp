@@ -15,10 +15,12 @@ struct DepthFilterSettings {
   float min_depth = 0.1f;  ///< metres; closer readings are invalid (below any RGB-D sensor's range)
   float max_depth = std::numeric_limits<float>::infinity();  ///< metres; farther readings are invalid
   int erode_radius = 1;  ///< pixels; 1 = 3x3 neighbourhood
-  /// metres; a neighbour farther than this in depth counts against the pixel. The original code's
-  /// 1 mm acted on depth stored in whole millimetres, where it means "2 mm or more"; 1.5 mm keeps
-  /// exactly that on millimetre data and does not flag sub-millimetre differences of float depth
-  /// (a Kinect's disparity step is 1.3 mm at 0.7 m: with 1 mm, half of a smooth surface was eroded).
+  /// metres; a neighbour farther than this in depth counts against the pixel, and farther than 3
+  /// standard deviations of the difference of two readings (3 sqrt(2) NoiseScale::spread(z)):
+  /// the test is for flying pixels and isolated readings, and noise alone must not erode. The
+  /// original code's 1 mm on whole millimetres (kept as 1.5 mm on float depth) flagged every
+  /// change of disparity level; at 2.5 m, where structured light's levels are 17 mm apart and
+  /// the noise flips readings between them, it eroded a fifth of a smooth surface.
   float erode_depth_diff = 0.0015f;
   float erode_ratio = 0.8f;  ///< a pixel is removed when this fraction of its neighbours count against it
   int smooth_radius = 2;  ///< pixels; 2 = 5x5 window
@@ -35,8 +37,8 @@ inline void invalidateOutOfRange(cv::Mat& depth, const DepthFilterSettings& s) {
 }
 
 /// Removes isolated readings and the flying pixels of depth edges: a valid pixel goes when at least
-/// erode_ratio of its neighbours are invalid or differ from it by more than erode_depth_diff
-/// (widened by `noise` at the pixel's depth).
+/// erode_ratio of its neighbours are invalid or differ from it by more than erode_depth_diff or
+/// three standard deviations of the difference of two readings at its depth.
 inline cv::Mat erodeDepth(const cv::Mat& depth, const DepthFilterSettings& s, const NoiseScale& noise = NoiseScale()) {
   CV_Assert(depth.type() == CV_32FC1);
   cv::Mat out = depth.clone();
@@ -46,7 +48,7 @@ inline cv::Mat erodeDepth(const cv::Mat& depth, const DepthFilterSettings& s, co
     const int v = pos[0], u = pos[1];
     const float z = depth.at<float>(v, u);
     if (z <= 0.0f || neighbours == 0) return;
-    const float diff = noise.widen(s.erode_depth_diff, z);
+    const float diff = std::max(s.erode_depth_diff, float(3.0 * std::sqrt(2.0) * noise.spread(z)));
     int against = 0;
     for (int dv = -r; dv <= r; ++dv) {
       for (int du = -r; du <= r; ++du) {

@@ -88,6 +88,9 @@ class NoiseScale {
   double at(double z) const { return z <= unit_depth_ ? 1.0 : std::max(1.0, ratio(z)); }
   double unitDepth() const { return unit_depth_; }
 
+  /// The spread of one reading at depth z (DepthNoise::spread).
+  double spread(double z) const { return noise_.spread(z, focal_px_); }
+
   /// `tolerance` widened for a reading at depth z.
   float widen(float tolerance, float z) const { return z <= unit_depth_ ? tolerance : float(tolerance * at(z)); }
 
