@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "bundletrack/residuals/dense_point_to_plane.hpp"
 #include "dense_host.hpp"
 
 namespace bundletrack::cuda {
@@ -103,8 +104,10 @@ void DensePointToPlane::lineariseAllWith(std::span<const Input> inputs, std::spa
     const detail::DeviceGrid* grid_i = w.grid(in.i);
     const detail::DeviceGrid* grid_j = w.grid(in.j);
     const SurfaceGate widened = gate.widened(NoiseScale::between(in.i.noise_scale, in.j.noise_scale));
-    w.passes.push_back({grid_i, grid_j, detail::directedPass(T_i, T_j, in.j.camera, widened, loss, weight)});
-    w.passes.push_back({grid_j, grid_i, detail::directedPass(T_j, T_i, in.i.camera, widened, loss, weight)});
+    const double weight_i = weight * bundletrack::DensePointToPlane::sampleWeight(in.i);
+    const double weight_j = weight * bundletrack::DensePointToPlane::sampleWeight(in.j);
+    w.passes.push_back({grid_i, grid_j, detail::directedPass(T_i, T_j, in.j.camera, widened, loss, weight_i)});
+    w.passes.push_back({grid_j, grid_i, detail::directedPass(T_j, T_i, in.i.camera, widened, loss, weight_j)});
   }
   w.sums.resize(w.passes.size() * detail::kDenseSums);
   detail::accumulateDense(*w.batch, w.passes.data(), int(w.passes.size()), w.sums.data());

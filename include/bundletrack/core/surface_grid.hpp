@@ -28,6 +28,7 @@ struct SurfaceGrid {
   std::vector<cv::Point> cells;  ///< grid cells with a point, row by row
   PinholeCameraf camera{};
   double noise_scale = 1.0;  ///< the sensor's NoiseScale at the points' median depth
+  int step = 1;  ///< full-resolution pixels between neighbouring cells
 
 
   bool inside(int u, int v) const { return u >= 0 && v >= 0 && u < points.cols && v < points.rows; }
@@ -48,6 +49,7 @@ inline int gridStepFor(const RgbdFrame& frame, const cv::Mat& mask, int target, 
 inline SurfaceGrid sampleSurface(const RgbdFrame& frame, const cv::Mat& mask, const PinholeCameraf& camera, int step) {
   SurfaceGrid grid;
   grid.camera = downsampledCamera(camera, step);
+  grid.step = step;
   const cv::Size size((frame.points.cols + step - 1) / step, (frame.points.rows + step - 1) / step);
   grid.points.create(size, CV_32FC3);
   grid.normals.create(size, CV_32FC3);

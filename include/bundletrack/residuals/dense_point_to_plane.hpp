@@ -15,8 +15,16 @@ namespace bundletrack {
 ///   r = m . (T_t^-1 p_t - T_s^-1 p_s),
 /// has dr/dd_s = [m^T, (b x m)^T] with b = T_t^-1 p_t, and dr/dd_t = -dr/dd_s (it depends on the
 /// relative pose only). Both directions of an edge are summed, as eq. 1 sums over ordered pairs.
+/// Each residual stands for the step^2 pixels its cell covers: its weight is sampleWeight(s),
+/// (step / 4)^2, so that the term is the same integral over the surface at any grid step and its
+/// balance with the feature term stays the one set for the original code's step 4.
 struct DensePointToPlane {
   SurfaceGate gate;  ///< the original code's 2 cm / 45 degrees
+
+  static constexpr int kReferenceStep = 4;
+  static double sampleWeight(const SurfaceGrid& s) {
+    return double(s.step * s.step) / double(kReferenceStep * kReferenceStep);
+  }
 
   struct Input {
     const SurfaceGrid& i;
@@ -27,8 +35,8 @@ struct DensePointToPlane {
   template <RobustLoss Loss>
   void linearise(const Input& in, const SE3d& T_i, const SE3d& T_j, const Loss& loss, double weight,
                  PairSystem& system) const {
-    addDirected(in.i, in.j, T_i, T_j, loss, weight, false, system);
-    addDirected(in.j, in.i, T_j, T_i, loss, weight, true, system);
+    addDirected(in.i, in.j, T_i, T_j, loss, weight * sampleWeight(in.i), false, system);
+    addDirected(in.j, in.i, T_j, T_i, loss, weight * sampleWeight(in.j), true, system);
     system.finish();
   }
 
