@@ -154,33 +154,28 @@ class Tracker {
   /// and that pose moved onto the object's points now) must pass the verifier's test for a pose
   /// with the surface alone behind it.
   bool reacquisitionCandidates(FrameContext& ctx, PairRegistration from_last) {
+    // Registrations with enough inliers, most first (the last good frame's first among equals).
+    std::vector<std::pair<int, CoarseEstimate>> registered;
+    const int last_inliers = ctx.result.inliers;
+    if (last_inliers >= settings_.min_inliers)
+      registered.push_back({last_inliers, {from_last.T_second_first * last_->T_cam_obj, true, true, Evidence::Features,
+                                           std::move(from_last.inliers)}});
+    if (last_inliers < settings_.recovery_min_inliers) {
+      for (const RelocalisedPose& pose :
+           relocalise(pool_, last_->T_cam_obj.rotation(), settings_.max_keyframes, settings_.min_inliers,
+                      [&](const Keyframe& keyframe) { return registerPair(keyframe.features, ctx.features, std::nullopt); }))
+        registered.push_back({pose.inliers, {pose.T_cam_obj, true, false, Evidence::Features, {}}});
+      std::stable_sort(registered.begin(), registered.end(),
+                       [](const auto& a, const auto& b) { return a.first > b.first; });
+    }
     std::vector<CoarseEstimate> by_surface;
-    const auto add = [&](const SE3d& T_cam_obj, int inliers, bool is_last) {
-      CoarseEstimate coarse{T_cam_obj, true, is_last, Evidence::Features, is_last ? from_last.inliers : std::vector<FeatureMatch>()};
+    for (auto& [inliers, coarse] : registered) {
       if (inliers >= settings_.recovery_min_inliers && ctx.candidates.empty()) {
         ctx.candidates.push_back(std::move(coarse));
       } else {
         coarse.evidence = Evidence::SurfaceOnly;
         by_surface.push_back(std::move(coarse));
       }
-    };
-    const SE3d from_last_pose = from_last.T_second_first * last_->T_cam_obj;
-    const int last_inliers = ctx.result.inliers;
-    if (last_inliers >= settings_.recovery_min_inliers) {
-      add(from_last_pose, last_inliers, true);
-    } else {
-      // The registration with the last good frame ranks among the keyframes' by its inliers.
-      bool last_added = last_inliers < settings_.min_inliers;
-      for (const RelocalisedPose& pose :
-           relocalise(pool_, last_->T_cam_obj.rotation(), settings_.max_keyframes, settings_.min_inliers,
-                      [&](const Keyframe& keyframe) { return registerPair(keyframe.features, ctx.features, std::nullopt); })) {
-        if (!last_added && last_inliers >= pose.inliers) {
-          add(from_last_pose, last_inliers, true);
-          last_added = true;
-        }
-        add(pose.T_cam_obj, pose.inliers, false);
-      }
-      if (!last_added) add(from_last_pose, last_inliers, true);
     }
     by_surface.push_back({last_->T_cam_obj, false, false, Evidence::SurfaceOnly, {}});
     if (const std::optional<SE3d> moved = movedOntoObject(ctx.masked))
