@@ -26,7 +26,8 @@ const char* const kUsage = R"(usage: bundletrack_synth --out DIR [options]
                      where its motion has taken it (its masks are empty meanwhile)
   --motion-blur N    average the colour over N instants of the exposure (1 = off)
   --sensor S         depth noise of structured_light (Kinect v1, Asus Xtion) | active_stereo
-                     (RealSense D4xx) (structured_light; bundletrack::DepthNoise)
+                     (RealSense D4xx) | time_of_flight (Azure Kinect) (structured_light;
+                     bundletrack::DepthNoise)
   --no-noise         perfect sensor: no depth noise, quantisation, dropouts or colour noise
   --seed N           random seed of textures and sensor noise (1)
 )";
@@ -97,7 +98,7 @@ int main(int argc, char** argv) {
       if (sensor == "structured_light") settings.sensor.depth_noise = bt::DepthNoise::structuredLight();
       else if (sensor == "active_stereo") settings.sensor.depth_noise = bt::DepthNoise::activeStereo();
       else if (sensor == "time_of_flight") settings.sensor.depth_noise = bt::DepthNoise::timeOfFlight();
-      else fail("unknown sensor '" + sensor + "' (structured_light | active_stereo)");
+      else fail("unknown sensor '" + sensor + "' (structured_light | active_stereo | time_of_flight)");
     } else if (arg == "--no-noise") {
       settings.sensor = bt::synth::SensorSettings::perfect();
     } else if (arg == "--seed") {

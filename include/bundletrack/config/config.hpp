@@ -164,7 +164,7 @@ inline std::vector<ConfigEntry> configEntries(Config& c) {
       {"masks", "search_margin_px", &m.search_margin_px, 0, 10000, "px", "propagated: keypoints are searched this far around the last pose's silhouette"},
       {"masks", "growth_px", &m.growth_px, 0, 10000, "px", "propagated: the mask reaches this far beyond the rendered silhouette"},
       {"masks", "depth_agreement", &m.depth_agreement, 0.0, 1.0, "m", "propagated: observed vs rendered depth that seeds the mask"},
-      {"masks", "depth_continuity", &m.depth_continuity, 0.0, 1.0, "m", "propagated: largest depth step between neighbouring mask pixels (up to 1 m; times z^2 beyond)"},
+      {"masks", "depth_continuity", &m.depth_continuity, 0.0, 1.0, "m", "propagated: largest depth step between neighbouring mask pixels (widened by the sensor's noise)"},
       {"masks", "hull_dilation_px", &m.hull_dilation_px, 0, 1000, "px", "propagated: slack of the first view's silhouette"},
       {"masks", "hull_depth_tolerance", &m.hull_depth_tolerance, 0.0, 1.0, "m", "propagated: slack in front of the first view's surface"},
       {"masks", "object_size_factor", &m.object_size_factor, 0.0, 100.0, "", "propagated, after lost: searched surfaces are at most this times the first view's extent"},
