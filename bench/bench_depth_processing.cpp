@@ -1,4 +1,5 @@
-// Per-stage cost of turning a 640x480 depth image into points and normals.
+// Per-stage cost of turning a 640x480 depth image into points and normals, and of doing so only
+// inside an object's region.
 #include <benchmark/benchmark.h>
 
 #include <random>
@@ -44,10 +45,18 @@ void BM_MakeFrame(benchmark::State& state) {
   for (auto _ : state) benchmark::DoNotOptimize(bt::makeFrame("0", color, depth, {}, kCamera));
 }
 
+// Only a 160x160 region (an object's box at about 1 m, Tracker::regionOfInterest) processed.
+void BM_MakeFrameRegion160(benchmark::State& state) {
+  const cv::Mat depth = noisyDepth();
+  const cv::Mat color(depth.size(), CV_8UC3, cv::Scalar::all(128));
+  for (auto _ : state) benchmark::DoNotOptimize(bt::makeFrame("0", color, depth, {}, kCamera, {}, {240, 160, 160, 160}));
+}
+
 }  // namespace
 
 BENCHMARK(BM_Erode)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_SmoothOnePass)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_PointsAndNormals)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_MakeFrame)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_MakeFrameRegion160)->Unit(benchmark::kMillisecond);
 BENCHMARK_MAIN();

@@ -1,19 +1,24 @@
 // bench_tracker [--sequence DIR ...] [--frames N] [--memory-every N] [--features F] [--gpu]
 // Runs the default tracker (with --features orb|akaze: that detector instead of SIFT; built by
-// makeTracker) on each sequence (or on a synthetic one rendered in memory) and prints,
-// per stage, the median and 90th percentile of the milliseconds per frame, the share of the
-// median frame, and frames per second (tracking only, and with reading + preprocessing).
+// makeTracker) on each sequence (or on a synthetic one rendered in memory) as bundletrack_track
+// does: files decoded a few frames ahead on another thread (io::ReadAhead), each frame
+// preprocessed inside the tracker's region of interest. Prints, per stage, the median and 90th
+// percentile of the milliseconds per frame and the share of the median frame; the whole run's
+// milliseconds per frame (files to poses) and, for sequences, the time to merely decode the same
+// files with OpenCV (colour, depth, mask; one pass before the run) and the ratio of the two.
 // --memory-every N also prints, every N frames, the keyframes in the pool and the process's
 // resident and peak resident memory (Linux /proc/self/status).
 // --gpu (builds with BUNDLETRACK_CUDA) also runs the tracker composed of the GPU policies on the
 // same frames and prints both per-stage medians side by side with the GPU/CPU ratio.
 #include <algorithm>
+#include <filesystem>
 #include <cstdio>
 #include <fstream>
 #include <memory>
 #include <string>
 #include <vector>
 
+#include "bundletrack/io/read_ahead.hpp"
 #include "bundletrack/io/ycbineoat_sequence.hpp"
 #include "bundletrack/runtime/make_tracker.hpp"
 #include "bundletrack/synth/synthetic_sequence.hpp"
@@ -31,6 +36,7 @@ double percentile(std::vector<double> v, double q) {
 
 struct Stages {
   std::vector<double> read, mask, features, matching, ransac, graph, solve, total;
+  double whole_run_ms = 0.0;  ///< wall time of frames 1 .. n-1, reading and preprocessing included
   void add(double read_ms, const bt::StageTimings& t) {
     read.push_back(read_ms), mask.push_back(t.mask), features.push_back(t.features), matching.push_back(t.matching);
     ransac.push_back(t.ransac), graph.push_back(t.graph), solve.push_back(t.solve), total.push_back(t.total);
@@ -39,7 +45,8 @@ struct Stages {
 
 void report(const std::string& name, const Stages& s) {
   const double median_total = percentile(s.total, 0.5);
-  std::printf("\n%s: %zu frames (read = loading and preprocessing, outside the tracker's total)\n%-10s %10s %10s %9s\n",
+  std::printf("\n%s: %zu frames (read = waiting for the decoded files and preprocessing the region of interest, "
+              "outside the tracker's total)\n%-10s %10s %10s %9s\n",
               name.c_str(), s.total.size(), "stage", "median ms", "p90 ms", "of total");
   const std::pair<const char*, const std::vector<double>*> rows[] = {
       {"read", &s.read},         {"mask", &s.mask},   {"features", &s.features}, {"matching", &s.matching},
@@ -47,10 +54,11 @@ void report(const std::string& name, const Stages& s) {
   for (const auto& [label, values] : rows)
     std::printf("%-10s %10.2f %10.2f %7.1f%%\n", label, percentile(*values, 0.5), percentile(*values, 0.9),
                 100.0 * percentile(*values, 0.5) / median_total);
-  double sum = 0.0, sum_read = 0.0;
-  for (std::size_t i = 0; i < s.total.size(); ++i) sum += s.total[i], sum_read += s.read[i];
-  std::printf("frames per second: %.1f tracking, %.1f with reading and preprocessing\n",
-              1000.0 * double(s.total.size()) / sum, 1000.0 * double(s.total.size()) / (sum + sum_read));
+  double sum = 0.0;
+  for (const double t : s.total) sum += t;
+  const double whole = s.whole_run_ms / double(s.total.size());
+  std::printf("frames per second: %.1f tracking; whole run %.2f ms per frame (%.1f fps) from the files to the poses\n",
+              1000.0 * double(s.total.size()) / sum, whole, 1000.0 / whole);
 }
 
 /// VmRSS and VmHWM of this process in MiB (0 where /proc is not available).
@@ -64,17 +72,29 @@ std::pair<double, double> residentMemoryMiB() {
   return {rss, peak};
 }
 
-template <typename FrameAt>
-Stages track(bt::AnyTracker& tracker, std::size_t frames, int memory_every, FrameAt&& frame_at) {
+/// A frame as decoded (or rendered) and its pose where known.
+struct Input {
+  bt::RawFrame raw;
+  bt::SE3d pose;
+};
+
+template <typename ReadAt>
+Stages track(bt::AnyTracker& tracker, const bt::PinholeCameraf& camera, std::size_t frames, int memory_every,
+             ReadAt&& read_at) {
   Stages stages;
   if (memory_every > 0) std::printf("%8s %10s %12s %13s %6s\n", "frame", "keyframes", "resident MiB", "peak MiB", "lost");
   int lost = 0;
+  bt::io::ReadAhead<Input> inputs(frames, read_at);
+  bt::Stopwatch whole_run;
   for (std::size_t i = 0; i < frames; ++i) {
     bt::Stopwatch read;
-    const auto [frame, pose] = frame_at(i);
+    Input input = inputs.next();
+    const cv::Rect region = tracker.regionOfInterest(input.raw.color.size(), input.raw.mask);
+    const bt::RgbdFrame frame = bt::makeFrame(std::move(input.raw), camera, {}, region);
     const double read_ms = read.lap();
-    const bt::TrackResult result = i == 0 ? tracker.initialize(frame, pose) : tracker.track(frame);
+    const bt::TrackResult result = i == 0 ? tracker.initialize(frame, input.pose) : tracker.track(frame);
     lost += result.status == bt::TrackStatus::Lost;
+    if (i == 0) whole_run.lap();
     if (i > 0) stages.add(read_ms, result.timings);
     if (memory_every > 0 && ((i + 1) % std::size_t(memory_every) == 0 || i + 1 == frames)) {
       const auto [rss, peak] = residentMemoryMiB();
@@ -82,7 +102,22 @@ Stages track(bt::AnyTracker& tracker, std::size_t frames, int memory_every, Fram
       std::fflush(stdout);
     }
   }
+  stages.whole_run_ms = whole_run.lap();
   return stages;
+}
+
+/// Milliseconds per frame to decode a sequence's files with OpenCV alone (colour, depth, mask).
+double decodeOnlyMs(const bt::io::YcbineoatSequence& sequence, std::size_t frames) {
+  bt::Stopwatch clock;
+  for (std::size_t i = 0; i < frames; ++i) {
+    const std::pair<std::filesystem::path, int> files[] = {{sequence.colorPath(i), cv::IMREAD_COLOR},
+                                                           {sequence.depthPath(i), cv::IMREAD_UNCHANGED},
+                                                           {sequence.maskPath(i), cv::IMREAD_GRAYSCALE}};
+    for (const auto& [path, flags] : files)
+      if (std::filesystem::exists(path) && cv::imread(path.string(), flags).empty())
+        throw bt::InputError(path, "cannot decode image");
+  }
+  return clock.lap() / double(frames);
 }
 
 /// Per-stage medians of two runs on the same frames, and their ratio.
@@ -107,20 +142,23 @@ struct Options {
 };
 
 /// The default tracker with the --features detector on the frames, and with --gpu the
-/// GPU-composed one as well.
-template <typename FrameAt>
+/// GPU-composed one as well. decode_ms: the files' decoding alone, per frame (0: not measured).
+template <typename ReadAt>
 void run(const std::string& name, const bt::PinholeCameraf& camera, std::size_t frames, const Options& options,
-         FrameAt&& frame_at) {
+         ReadAt&& read_at, double decode_ms = 0.0) {
   bt::Config config;
   config.features = options.features;
   const std::unique_ptr<bt::AnyTracker> cpu_tracker = bt::makeTracker(config, camera);
   config.device = "gpu";
   const std::unique_ptr<bt::AnyTracker> gpu_tracker = options.gpu ? bt::makeTracker(config, camera) : nullptr;
   const std::string label = name + " [" + options.features + "]";
-  const Stages cpu = track(*cpu_tracker, frames, options.memory_every, frame_at);
+  const Stages cpu = track(*cpu_tracker, camera, frames, options.memory_every, read_at);
   report(label, cpu);
+  if (decode_ms > 0.0)
+    std::printf("decoding the files alone (OpenCV: colour, depth, mask): %.2f ms per frame; whole run / decoding = %.2f\n",
+                decode_ms, cpu.whole_run_ms / double(cpu.total.size()) / decode_ms);
   if (!gpu_tracker) return;
-  const Stages gpu = track(*gpu_tracker, frames, 0, frame_at);
+  const Stages gpu = track(*gpu_tracker, camera, frames, 0, read_at);
   report(label + " (GPU policies: cuda::PCG, cuda::GpuMatched, cuda::DensePointToPlane, cuda::Ransac)", gpu);
   compare(cpu, gpu);
 }
@@ -136,6 +174,10 @@ int main(int argc, char** argv) {
     if (arg == "--gpu") {
       options.gpu = true;
       continue;
+    }
+    if (arg == "--help" || arg == "-h") {
+      std::printf("%s", usage);
+      return 0;
     }
     if (i + 1 >= argc) {
       std::fprintf(stderr, "%s needs a value\n%s", arg.c_str(), usage);
@@ -160,14 +202,18 @@ int main(int argc, char** argv) {
       run("synthetic hand-held box (rendering counted as reading)", camera, std::size_t(frames), options,
           [&](std::size_t i) {
             const auto f = scene.frame(int(i));
-            return std::pair(bt::makeFrame(std::to_string(i), f.color, f.depth, f.mask, camera), f.T_cam_obj);
+            return Input{{std::to_string(i), f.color, f.depth, f.mask}, f.T_cam_obj};
           });
     }
     for (const auto& dir : options.sequences) {
       const bt::io::YcbineoatSequence sequence(dir);
-      run(dir, sequence.camera().cast<float>(), sequence.size(), options, [&](std::size_t i) {
-        return std::pair(sequence.frame(i), sequence.hasGroundTruth() ? sequence.groundTruthPose(i) : bt::SE3d());
-      });
+      const double decode_ms = decodeOnlyMs(sequence, sequence.size());
+      run(
+          dir, sequence.camera().cast<float>(), sequence.size(), options,
+          [&](std::size_t i) {
+            return Input{sequence.read(i), sequence.hasGroundTruth() ? sequence.groundTruthPose(i) : bt::SE3d()};
+          },
+          decode_ms);
     }
   } catch (const std::exception& error) {
     std::fprintf(stderr, "error: %s\n", error.what());

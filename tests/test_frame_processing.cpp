@@ -109,3 +109,37 @@ TEST_CASE("range check zeroes non-finite and out-of-range depth") {
   CHECK(cv::countNonZero(depth) == 1);
   CHECK(depth.at<float>(0, 2) == 1.0f);
 }
+
+TEST_CASE("a frame preprocessed inside a region equals the whole image's preprocessing there, zero elsewhere") {
+  // A slanted plane with noise, steps and holes: every filter (erosion, both smoothing passes,
+  // normals) has work at the regions' borders.
+  const cv::Size size(128, 96);
+  cv::Mat depth = planeDepth(Eigen::Vector3f(0.2f, -0.3f, -1.0f).normalized(), -0.8f, size);
+  std::mt19937 rng(7);
+  std::normal_distribution<float> noise(0.0f, 0.002f);
+  std::uniform_int_distribution<int> hole(0, 9);
+  for (auto it = depth.begin<float>(); it != depth.end<float>(); ++it) *it = hole(rng) == 0 ? 0.0f : *it + noise(rng);
+  depth(cv::Rect(40, 20, 30, 40)) += 0.08f;  // a step farther than every depth window
+  const cv::Mat color(size, CV_8UC3, cv::Scalar::all(128));
+  bt::FrameSettings settings;
+  settings.sensor = bt::DepthNoise::activeStereo();  // tolerances that vary with depth
+  const bt::RgbdFrame whole = bt::makeFrame("whole", color, depth, cv::Mat(), kCamera, settings);
+  CHECK(whole.region == cv::Rect({0, 0}, size));
+  for (const cv::Rect region : {cv::Rect(30, 15, 50, 45), cv::Rect(0, 0, 20, 96), cv::Rect(100, 70, 60, 60)}) {
+    const bt::RgbdFrame part = bt::makeFrame("part", color, depth, cv::Mat(), kCamera, settings, region);
+    const cv::Rect inside = region & cv::Rect({0, 0}, size);
+    CAPTURE(inside);
+    CHECK(part.region == inside);
+    CHECK(cv::countNonZero(part.depth(inside)) > inside.area() / 2);
+    CHECK(cv::norm(part.depth(inside), whole.depth(inside), cv::NORM_INF) == 0.0);
+    CHECK(cv::norm(part.points(inside), whole.points(inside), cv::NORM_INF) == 0.0);
+    CHECK(cv::norm(part.normals(inside), whole.normals(inside), cv::NORM_INF) == 0.0);
+    cv::Mat outside(size, CV_8UC1, cv::Scalar(255));
+    outside(inside).setTo(0);
+    for (const cv::Mat& image : {part.depth, part.points, part.normals}) {
+      cv::Mat left = cv::Mat::zeros(size, image.type());
+      image.copyTo(left, outside);
+      CHECK(cv::countNonZero(left.reshape(1)) == 0);
+    }
+  }
+}

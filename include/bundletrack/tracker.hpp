@@ -6,6 +6,7 @@
 
 #include "bundletrack/core/angles.hpp"
 #include "bundletrack/core/error.hpp"
+#include "bundletrack/core/image_region.hpp"
 #include "bundletrack/energy.hpp"
 #include "bundletrack/features/correspondence_source.hpp"
 #include "bundletrack/graph/keyframe_pool.hpp"
@@ -43,6 +44,17 @@ class Tracker {
         registration_(std::move(registration)), verifier_(std::move(verifier)), pool_(settings.pool_capacity) {}
 
   const KeyframePool& keyframes() const { return pool_; }
+
+  /// The part of the next frame's image the tracker will read depth from (pass it to makeFrame:
+  /// only that part is then preprocessed): the mask source's region (GivenMasks: the box of
+  /// `given_mask`, the frame's mask from the data; PropagatedMasks: around the last pose's
+  /// silhouette) grown by kRegionMargin; the whole image before initialize() and after a loss
+  /// without a given mask.
+  cv::Rect regionOfInterest(cv::Size image, const cv::Mat& given_mask = {}) const {
+    if (!last_) return cv::Rect({0, 0}, image);
+    const std::optional<SE3d> guess = lost_streak_ > 0 ? std::nullopt : std::optional(last_->T_cam_obj);
+    return grownWithin(masks_.regionOfInterest(image, given_mask, observed(), guess), kRegionMargin, image);
+  }
 
   /// Starts the track: the first frame with its mask and pose is keyframe 0, the graph's fixed node.
   TrackResult initialize(const RgbdFrame& frame, const SE3d& T_cam_obj = {}) {

@@ -7,11 +7,14 @@
 #include "bundletrack/core/camera.hpp"
 #include "bundletrack/core/depth_filter.hpp"
 #include "bundletrack/core/depth_noise.hpp"
+#include "bundletrack/core/image_region.hpp"
 #include "bundletrack/core/point_map.hpp"
 
 namespace bundletrack {
 
-/// One RGB-D observation, preprocessed. Every image has the colour image's size.
+/// One RGB-D observation, preprocessed. Every image has the colour image's size; depth, points and
+/// normals are computed inside `region` only (the whole image unless makeFrame was given less),
+/// and are zero (invalid) outside it.
 struct RgbdFrame {
   std::string name;  ///< the frame's file stem, e.g. "000042"
   cv::Mat color;  ///< CV_8UC3, BGR
@@ -20,6 +23,15 @@ struct RgbdFrame {
   cv::Mat points;  ///< CV_32FC3, camera-frame points; 0 where depth is invalid
   cv::Mat normals;  ///< CV_32FC3, unit normals facing the camera; 0 where undefined
   NoiseScale noise;  ///< the depth sensor's noise, for tolerances on this frame's depths
+  cv::Rect region;  ///< where depth, points and normals were computed
+};
+
+/// One RGB-D observation as decoded, before preprocessing.
+struct RawFrame {
+  std::string name;
+  cv::Mat color;  ///< CV_8UC3, BGR
+  cv::Mat depth;  ///< CV_32FC1, metres as measured; 0 = no reading
+  cv::Mat mask;  ///< CV_8UC1, empty when the data has no mask for this frame
 };
 
 struct FrameSettings {
@@ -28,16 +40,48 @@ struct FrameSettings {
   DepthNoise sensor = DepthNoise::structuredLight();  ///< widens the depth tolerances (NoiseScale)
 };
 
+/// How far (pixels) a preprocessed pixel depends on the raw depth around it: erosion, then each
+/// smoothing pass, then the normals' differences.
+inline int preprocessingReach(const FrameSettings& s) {
+  return s.depth_filter.erode_radius + s.depth_filter.smooth_passes * s.depth_filter.smooth_radius + 1;
+}
+
 /// Filters the raw depth (metres) and derives points and normals, the depth tolerances widened by
-/// the sensor's noise.
+/// the sensor's noise. With a region (Tracker::regionOfInterest: the object's neighbourhood), only
+/// that part of the image is processed, from the raw depth within preprocessingReach of it, so the
+/// result inside the region is the one of processing the whole image; outside it is zero.
 inline RgbdFrame makeFrame(std::string name, cv::Mat color, const cv::Mat& raw_depth, cv::Mat mask,
-                           const PinholeCameraf& camera, const FrameSettings& settings = {}) {
+                           const PinholeCameraf& camera, const FrameSettings& settings = {}, cv::Rect region = {}) {
+  const cv::Rect image({0, 0}, raw_depth.size());
+  region = region.area() > 0 ? region & image : image;
   const NoiseScale noise(settings.sensor, camera.fx);
-  RgbdFrame frame{std::move(name), std::move(color), filterDepth(raw_depth, settings.depth_filter, noise),
-                  std::move(mask), {}, {}, noise};
-  frame.points = unprojectDepth(frame.depth, camera);
-  frame.normals = estimateNormals(frame.points, settings.normal_max_depth_jump, noise);
+  RgbdFrame frame{std::move(name), std::move(color), {}, std::move(mask), {}, {}, noise, region};
+  if (region == image) {
+    frame.depth = filterDepth(raw_depth, settings.depth_filter, noise);
+    frame.points = unprojectDepth(frame.depth, camera);
+    frame.normals = estimateNormals(frame.points, settings.normal_max_depth_jump, noise);
+    return frame;
+  }
+  const cv::Rect around = grownWithin(region, preprocessingReach(settings), image.size());
+  PinholeCameraf shifted = camera;  // pixel (u, v) of the image is (u - around.x, v - around.y) of the crop
+  shifted.cx -= float(around.x);
+  shifted.cy -= float(around.y);
+  const cv::Mat depth = filterDepth(raw_depth(around), settings.depth_filter, noise);
+  const cv::Mat points = unprojectDepth(depth, shifted);
+  const cv::Mat normals = estimateNormals(points, settings.normal_max_depth_jump, noise);
+  const cv::Rect inside = region - around.tl();
+  frame.depth = cv::Mat::zeros(image.size(), CV_32FC1);
+  frame.points = cv::Mat::zeros(image.size(), CV_32FC3);
+  frame.normals = cv::Mat::zeros(image.size(), CV_32FC3);
+  depth(inside).copyTo(frame.depth(region));
+  points(inside).copyTo(frame.points(region));
+  normals(inside).copyTo(frame.normals(region));
   return frame;
+}
+
+inline RgbdFrame makeFrame(RawFrame raw, const PinholeCameraf& camera, const FrameSettings& settings = {},
+                           cv::Rect region = {}) {
+  return makeFrame(std::move(raw.name), std::move(raw.color), raw.depth, std::move(raw.mask), camera, settings, region);
 }
 
 }  // namespace bundletrack

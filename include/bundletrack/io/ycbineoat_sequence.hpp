@@ -58,17 +58,25 @@ class YcbineoatSequence {
 
   /// Loads and preprocesses frame i. Throws InputError for an unreadable file, a size mismatch or
   /// a depth image without a single valid reading.
-  RgbdFrame frame(std::size_t i) const {
+  RgbdFrame frame(std::size_t i) const { return preprocess(read(i)); }
+
+  /// Decodes frame i's files (colour, depth in metres, the mask if there is one), nothing more;
+  /// safe to call from another thread (to read ahead), throws as frame() does.
+  RawFrame read(std::size_t i) const {
     cv::Mat color = readColor(colorPath(i));
     requireSize(color, colorPath(i));
-    cv::Mat object_mask = mask(i).value_or(cv::Mat());
-    return makeFrame(names_[i], std::move(color), rawDepth(i), std::move(object_mask), camera_.cast<float>(),
-                     settings_.frame);
+    return {names_.at(i), std::move(color), rawDepth(i), mask(i).value_or(cv::Mat())};
+  }
+
+  /// Preprocesses a frame from read(), only inside `region` (Tracker::regionOfInterest; empty:
+  /// the whole image), with the sequence's frame settings.
+  RgbdFrame preprocess(RawFrame raw, cv::Rect region = {}) const {
+    return makeFrame(std::move(raw), camera_.cast<float>(), settings_.frame, region);
   }
 
   /// Depth of frame i in metres as stored, before filtering.
   cv::Mat rawDepth(std::size_t i) const {
-    const auto path = root_ / "depth" / (names_.at(i) + ".png");
+    const auto path = depthPath(i);
     const cv::Mat depth = readDepth(path, settings_.depth_scale);
     requireSize(depth, path);
     if (cv::countNonZero(depth) == 0) throw InputError(path, "depth image has no valid pixel (all zero)");
@@ -83,6 +91,11 @@ class YcbineoatSequence {
     requireSize(m, path);
     return m;
   }
+
+  /// Frame i's files (the mask's may not exist).
+  std::filesystem::path colorPath(std::size_t i) const { return root_ / "rgb" / color_files_.at(i); }
+  std::filesystem::path depthPath(std::size_t i) const { return root_ / "depth" / (names_.at(i) + ".png"); }
+  std::filesystem::path maskPath(std::size_t i) const { return root_ / "masks" / (names_.at(i) + ".png"); }
 
   bool hasGroundTruth() const { return std::filesystem::is_directory(root_ / "annotated_poses"); }
   SE3d groundTruthPose(std::size_t i) const { return readPose(root_ / "annotated_poses" / (names_.at(i) + ".txt")); }
@@ -133,7 +146,7 @@ class YcbineoatSequence {
     for (int v = 0; v < depth.rows; ++v)
       for (int u = 0; u < depth.cols; ++u)
         if (first_mask.at<uchar>(v, u) && depth.at<float>(v, u) > 0.0f) values.push_back(depth.at<float>(v, u));
-    const auto path = root_ / "depth" / (names_[0] + ".png");
+    const auto path = depthPath(0);
     if (values.empty()) throw InputError(path, "no valid depth under the first frame's object mask");
     std::nth_element(values.begin(), values.begin() + std::ptrdiff_t(values.size() / 2), values.end());
     const double median = values[values.size() / 2], scale = settings_.depth_scale;
@@ -154,8 +167,6 @@ class YcbineoatSequence {
                                  std::to_string(image_size_.height));
   }
 
-  std::filesystem::path colorPath(std::size_t i) const { return root_ / "rgb" / color_files_.at(i); }
-  std::filesystem::path maskPath(std::size_t i) const { return root_ / "masks" / (names_.at(i) + ".png"); }
   std::filesystem::path modelPath() const { return root_ / "model" / "points.xyz"; }
 
   std::filesystem::path root_;

@@ -3,6 +3,7 @@
 #include <optional>
 
 #include "bundletrack/core/error.hpp"
+#include "bundletrack/core/image_region.hpp"
 #include "bundletrack/masks/mask_source.hpp"
 
 namespace bundletrack {
@@ -10,6 +11,12 @@ namespace bundletrack {
 /// Masks that come with the data (the frame's own mask, e.g. from masks/<name>.png): the same
 /// mask whatever the tracker knows.
 struct GivenMasks {
+  /// The given mask's bounding box; the whole image without one (track() then reports it).
+  cv::Rect regionOfInterest(cv::Size image, const cv::Mat& given_mask, const ObservedObject&,
+                            const std::optional<SE3d>&) const {
+    return maskBoxOrWhole(given_mask, image);
+  }
+
   cv::Mat start(const RgbdFrame& first, const PinholeCameraf&, const SE3d&, int) {
     if (first.mask.empty() || cv::countNonZero(first.mask) == 0)
       throw InputError("frame " + first.name, "the first frame needs a non-empty object mask");

@@ -16,7 +16,10 @@ namespace bundletrack {
 /// the object, all zero where it is not visible. The tracker asks three times per frame, giving
 /// what it knows; a source whose masks exist independently of the track (GivenMasks: from the
 /// data or a segmentation network) ignores the poses, one that follows the object (PropagatedMasks)
-/// renders what was seen (`object`) under them:
+/// renders what was seen (`object`) under them. Before the frame is preprocessed:
+/// - `regionOfInterest(image, given_mask, object, T_guess)`: the part of the image whose depth the
+///   three calls below will read (given_mask: the frame's mask from the data, empty if none);
+/// then:
 /// - `start(first, camera, T_cam_obj, grid_step)`: the first frame and its pose; returns its mask;
 /// - `searchRegion(frame, object, T_guess)`: where to look for keypoints before the coarse pose is
 ///   known (std::nullopt: no idea where the object is, e.g. after it was lost);
@@ -24,7 +27,9 @@ namespace bundletrack {
 ///   final one; returning the same cv::Mat again means the mask does not depend on the pose).
 template <typename T>
 concept MaskSource = requires(T& source, const T& const_source, const RgbdFrame& frame, const PinholeCameraf& camera,
-                              const SE3d& pose, const ObservedObject& object, const std::optional<SE3d>& guess, int step) {
+                              const SE3d& pose, const ObservedObject& object, const std::optional<SE3d>& guess, int step,
+                              cv::Size image, const cv::Mat& given_mask) {
+  { const_source.regionOfInterest(image, given_mask, object, guess) } -> std::same_as<cv::Rect>;
   { source.start(frame, camera, pose, step) } -> std::same_as<cv::Mat>;
   { const_source.searchRegion(frame, object, guess) } -> std::same_as<cv::Mat>;
   { const_source.mask(frame, object, pose) } -> std::same_as<cv::Mat>;

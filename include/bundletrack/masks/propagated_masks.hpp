@@ -8,6 +8,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "bundletrack/core/error.hpp"
+#include "bundletrack/core/image_region.hpp"
 #include "bundletrack/core/surface_grid.hpp"
 #include "bundletrack/masks/depth_segments.hpp"
 #include "bundletrack/masks/first_view_hull.hpp"
@@ -63,6 +64,20 @@ class PropagatedMasks {
     first_depth_ = float(cv::mean(first.depth, seen)[0]);
     started_ = true;
     return first.mask;
+  }
+
+  /// Without a guess (the object was lost) the whole image; else the box of the silhouette at the
+  /// guess grown by the search margin (the keypoints' region) and the mask's growth (the coarse
+  /// pose found there moves the silhouette at most that far).
+  cv::Rect regionOfInterest(cv::Size image, const cv::Mat&, const ObservedObject& object,
+                            const std::optional<SE3d>& T_guess) const {
+    const cv::Rect whole({0, 0}, image);
+    if (!started_ || !T_guess) return whole;
+    const cv::Size grid((image.width + grid_step_ - 1) / grid_step_, (image.height + grid_step_ - 1) / grid_step_);
+    const cv::Rect cells = cv::boundingRect(renderDepth(object.surfaces(*T_guess), *T_guess, grid) > 0.0f);
+    if (cells.area() == 0) return whole;
+    const cv::Rect pixels(cells.x * grid_step_, cells.y * grid_step_, cells.width * grid_step_, cells.height * grid_step_);
+    return grownWithin(pixels, settings_.search_margin_px + settings_.growth_px + grid_step_, image);
   }
 
   cv::Mat searchRegion(const RgbdFrame& frame, const ObservedObject& object, const std::optional<SE3d>& T_guess) const {

@@ -17,6 +17,9 @@ class AnyTracker {
   virtual ~AnyTracker() = default;
   virtual TrackResult initialize(const RgbdFrame& frame, const SE3d& T_cam_obj) = 0;
   virtual TrackResult track(const RgbdFrame& frame) = 0;
+  /// The part of the next frame's image to preprocess (Tracker::regionOfInterest); the whole
+  /// image for a tracker that does not say.
+  virtual cv::Rect regionOfInterest(cv::Size image, const cv::Mat& given_mask) const = 0;
   /// Keyframes in memory (0 for a tracker without a pool).
   virtual std::size_t keyframeCount() const = 0;
 };
@@ -31,6 +34,12 @@ class ErasedTracker final : public AnyTracker {
     return tracker_.initialize(frame, T_cam_obj);
   }
   TrackResult track(const RgbdFrame& frame) override { return tracker_.track(frame); }
+  cv::Rect regionOfInterest(cv::Size image, const cv::Mat& given_mask) const override {
+    if constexpr (requires { tracker_.regionOfInterest(image, given_mask); })
+      return tracker_.regionOfInterest(image, given_mask);
+    else
+      return cv::Rect({0, 0}, image);
+  }
   std::size_t keyframeCount() const override {
     if constexpr (requires { tracker_.keyframes().size(); }) return tracker_.keyframes().size();
     else return 0;

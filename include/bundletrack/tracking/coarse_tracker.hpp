@@ -3,6 +3,7 @@
 #include <optional>
 
 #include "bundletrack/core/error.hpp"
+#include "bundletrack/core/image_region.hpp"
 #include "bundletrack/features/correspondence_source.hpp"
 #include "bundletrack/registration/feature_registration.hpp"
 #include "bundletrack/tracking/stage_clock.hpp"
@@ -37,6 +38,11 @@ class CoarseTracker {
     TrackResult result{T_cam_obj, TrackStatus::Tracked, int(reference_->size()), 0, 0, frame.mask, {}};
     result.timings = clock_.stop();
     return result;
+  }
+
+  /// The part of the next frame to preprocess: the box of its mask, grown by kRegionMargin.
+  cv::Rect regionOfInterest(cv::Size image, const cv::Mat& given_mask) const {
+    return grownWithin(maskBoxOrWhole(given_mask, image), kRegionMargin, image);
   }
 
   TrackResult track(const RgbdFrame& frame) {
