@@ -105,7 +105,7 @@ run_cell() {  # name options sequence
   [ -n "$before" ] && before_fields=$(track "$before" "$seq" "$out/runs/before/$name" reuse)
   echo "$name,\"$options\",$after,$before_fields" >> "$csv_file"
   echo "$name: $after | before: $before_fields"
-  if [[ $name == *_mug_* ]]; then
+  if [[ $name == *_mug_* && $name != real_* ]]; then
     [ -n "$before" ] && mug_before=$($py "$(dirname "$0")/mug_rotation.py" "$seq" "$out/runs/before/$name")
     echo "$name,$($py "$(dirname "$0")/mug_rotation.py" "$seq" "$out/runs/after/$name"),$mug_before" >> "$mug_csv"
   fi

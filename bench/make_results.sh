@@ -1,9 +1,19 @@
 #!/usr/bin/env bash
 # Regenerates bench/RESULTS.md from a fresh run of the benchmarks (build first; see README).
-# Usage: bash bench/make_results.sh [build-dir]   (about 13 minutes on 2 cores: the 3,000-frame
-# memory run takes half of it, the Open3D peers a third; the peers need python3-open3d)
+# Usage: bash bench/make_results.sh [build-dir] [--before DIR --before-label TEXT]
+# (about 25 minutes on 2 cores: the 10,000-frame memory run takes half of it, the Open3D peers a third; the
+# peers need python3-open3d). --before: a folder with an earlier build's bench_tracker and
+# bundletrack_track, run in the same session beside this build's (per-stage tables, peers).
 set -euo pipefail
-build=${1:-build}
+build=build before="" before_label="before"
+while [ $# -gt 0 ]; do
+  case "$1" in
+    --before) before=$2; shift 2 ;;
+    --before-label) before_label=$2; shift 2 ;;
+    *) build=$1; shift ;;
+  esac
+done
+bin_of() { [ -x "$1/bin/$2" ] && echo "$1/bin/$2" || echo "$1/$2"; }
 out=$(dirname "$0")/RESULTS.md
 # awk prologue shared by the tables: maps Google Benchmark's CSV header (counters are quoted) to
 # column numbers in col[], and skips every line that is not a benchmark row.
@@ -86,6 +96,15 @@ depth=$("$build/bin/bench_depth_processing" --benchmark_format=csv 2>/dev/null)
   "$build/bin/bench_tracker" --frames 150
   [ ${#args[@]} -gt 0 ] && "$build/bin/bench_tracker" "${args[@]}"
   echo '```'
+  if [ -n "$before" ]; then
+    echo
+    echo "### The same, $before_label (its own bench_tracker, run right after the above)"
+    echo
+    echo '```'
+    "$(bin_of "$before" bench_tracker)" --frames 150
+    [ ${#args[@]} -gt 0 ] && "$(bin_of "$before" bench_tracker)" "${args[@]}"
+    echo '```'
+  fi
   echo
   echo "## Tracker per stage with ORB keypoints (bench_tracker --features orb)"
   echo
@@ -114,14 +133,14 @@ depth=$("$build/bin/bench_depth_processing" --benchmark_format=csv 2>/dev/null)
     echo '```'
   fi
   echo
-  echo "## Memory over a 3,000-frame synthetic run (bench_tracker --frames 3000 --memory-every 250)"
+  echo "## Memory over a 10,000-frame synthetic run (bench_tracker --frames 10000 --memory-every 1000)"
   echo
   echo "Resident and peak resident memory of the whole process (rendering included) while the"
   echo "default tracker runs; the pool holds at most graph.pool_capacity = 200 keyframes, and frames"
   echo "join it only with a novel view (10 degrees from every keyframe)."
   echo
   echo '```'
-  "$build/bin/bench_tracker" --frames 3000 --memory-every 250 | sed -n '1,/^$/p' | sed '/^$/d'
+  "$build/bin/bench_tracker" --frames 10000 --memory-every 1000 | sed -n '1,/^$/p' | sed '/^$/d'
   echo '```'
   echo
   echo "## Peers: Open3D frame-to-frame registration (bench/peers.py)"
@@ -132,7 +151,9 @@ depth=$("$build/bin/bench_depth_processing" --benchmark_format=csv 2>/dev/null)
     echo "the image files to the pose on this CPU machine (Open3D $(/usr/bin/python3 -c 'import open3d; print(open3d.__version__)'),"
     echo "Debian build); ours / method time < 1 means ours is faster. A failed step keeps the last pose."
     echo
-    /usr/bin/python3 "$(dirname "$0")/peers.py" --build "$build" --out "$build/peers" "${sequences[@]}"
+    before_args=()
+    [ -n "$before" ] && before_args=(--before "$before" --before-label "$before_label")
+    /usr/bin/python3 "$(dirname "$0")/peers.py" --build "$build" --out "$build/peers" "${before_args[@]}" "${sequences[@]}"
   else
     echo "Not run: needs ../shared/data sequences and the Debian packages python3-open3d, python3-opencv."
   fi

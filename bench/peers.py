@@ -1,7 +1,8 @@
 #!/usr/bin/python3
 """Peer comparison: bundletrack against Open3D's frame-to-frame registration, same data, one run.
 
-usage: /usr/bin/python3 bench/peers.py --build BUILD_DIR --out DIR SEQUENCE_DIR [SEQUENCE_DIR ...]
+usage: /usr/bin/python3 bench/peers.py --build BUILD_DIR --out DIR [--before BUILD_DIR --before-label TEXT]
+                                      SEQUENCE_DIR [SEQUENCE_DIR ...]
 
 Every method starts from the annotated first pose, sees each frame's given mask, and chains
 frame-to-frame estimates (no re-initialisation). Open3D methods, on the masked object:
@@ -10,8 +11,13 @@ frame-to-frame estimates (no re-initialisation). Open3D methods, on the masked o
   rgbd_odometry       Open3D RGB-D odometry (Steinbruecker et al. 2011 with the hybrid
                       photometric + depth term of Park et al.) on the masked depth
 Time per frame counts everything from the image files to the pose (decoding included) for every
-method; ours is bundletrack_track's read_ms + total_ms. Poses are scored by bundletrack_eval (ADD
-and ADD-S AUC on [0, 10 cm], 5deg5cm), so every method goes through the same evaluation.
+method: for Open3D the loop over the frames after the first in this process (interpreter start
+and imports not counted), for ours the whole bundletrack_track process (start, initialisation on
+the first frame and the final scoring included) divided by the number of frames. With --before,
+a second build's bundletrack_track runs the same way in the same run. The row "decoding only" is the
+time OpenCV takes to decode the same files (colour, depth, mask), the floor of any method reading
+them. Poses are scored by bundletrack_eval (ADD and ADD-S AUC on [0, 10 cm], 5deg5cm), so every
+method goes through the same evaluation.
 Needs the Debian packages python3-open3d, python3-opencv and python3-numpy.
 """
 import argparse
@@ -127,19 +133,31 @@ def run_open3d(sequence, method, out):
             else:
                 pose = np.linalg.inv(step) @ pose  # step maps frame t into frame t-1
         previous = current
+        write_pose(os.path.join(out, "poses", name + ".txt"), pose)
         if i > 0:
             times.append(1e3 * (time.perf_counter() - start))
-        write_pose(os.path.join(out, "poses", name + ".txt"), pose)
-    return statistics.median(times), failures
+    return statistics.mean(times), failures
+
+
+def decode_only(sequence):
+    """Milliseconds per frame to decode the colour, depth and mask files, frames after the first."""
+    start = time.perf_counter()
+    for name in sequence.names[1:]:
+        sequence.frame(name)
+        sequence.image("masks", name, cv2.IMREAD_GRAYSCALE)
+    return 1e3 * (time.perf_counter() - start) / (len(sequence.names) - 1)
 
 
 def run_ours(build, sequence, out):
-    subprocess.run([os.path.join(build, "bin", "bundletrack_track"), "--sequence", sequence.root, "--out", out, "--quiet"],
-                   check=True, stdout=subprocess.DEVNULL)
+    binary = os.path.join(build, "bin", "bundletrack_track")
+    if not os.path.exists(binary):
+        binary = os.path.join(build, "bundletrack_track")
+    start = time.perf_counter()
+    subprocess.run([binary, "--sequence", sequence.root, "--out", out, "--quiet"], check=True, stdout=subprocess.DEVNULL)
+    ms = 1e3 * (time.perf_counter() - start) / len(sequence.names)
     with open(os.path.join(out, "track.csv")) as f:
         rows = list(csv.DictReader(f))[1:]
-    times = [float(r["read_ms"]) + float(r["total_ms"]) for r in rows]
-    return statistics.median(times), sum(r["status"] == "lost" for r in rows)
+    return ms, sum(r["status"] == "lost" for r in rows)
 
 
 def score(build, sequence, poses, json_path):
@@ -153,6 +171,8 @@ def main():
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--build", default="build")
     parser.add_argument("--out", default="build/peers")
+    parser.add_argument("--before", help="a second build (or folder with bundletrack_track) run beside ours")
+    parser.add_argument("--before-label", default="before")
     parser.add_argument("sequences", nargs="+")
     parser.add_argument("--methods", default="bundletrack,icp_point_to_plane,icp_colored,rgbd_odometry",
                         help="comma-separated subset; bundletrack must be one (the time ratios refer to it)")
@@ -160,6 +180,9 @@ def main():
     methods = args.methods.split(",")
     if "bundletrack" not in methods:
         parser.error("--methods must include bundletrack")
+    before = f"bundletrack ({args.before_label})"
+    if args.before:
+        methods.insert(methods.index("bundletrack") + 1, before)
     print("| sequence | method | ADD AUC | ADD-S AUC | 5deg5cm | ms per frame | ours / method time | failed steps |")
     print("|---|---|---|---|---|---|---|---|")
     for root in args.sequences:
@@ -170,6 +193,9 @@ def main():
             out = os.path.join(args.out, name, method)
             if method == "bundletrack":
                 ms, failures = run_ours(args.build, sequence, out)
+            elif method == before:
+                out = os.path.join(args.out, name, "bundletrack_before")
+                ms, failures = run_ours(args.before, sequence, out)
             else:
                 ms, failures = run_open3d(sequence, method, out)
             results[method] = (score(args.build, sequence, os.path.join(out, "poses"), os.path.join(out, "score.json")),
@@ -179,6 +205,8 @@ def main():
             s, ms, failures = results[method]
             print(f"| {name} | {method} | {s['ADD']:.1f} | {s['ADD_S']:.1f} | {s['deg5cm5']:.1f}% | {ms:.1f} | "
                   f"{ours_ms / ms:.2f} | {failures} |")
+        decode_ms = decode_only(sequence)
+        print(f"| {name} | decoding only (OpenCV) | | | | {decode_ms:.1f} | {ours_ms / decode_ms:.2f} | |")
         sys.stdout.flush()
 
 
