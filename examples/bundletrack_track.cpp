@@ -279,13 +279,15 @@ int main(int argc, char** argv) {
     for (const auto& [option, text] : overrides) {
       if (option == "--tracker") config.tracker = text;
       else if (option == "--features") config.features = text;
-      else if (option == "--depth-scale") config.sequence.depth_scale = number(option, text);
-      else if (option == "--min-inliers") config.tracking.min_inliers = int(number(option, text));
-      else if (option == "--inlier-mm") config.ransac.inlier_distance = float(number(option, text) * 1e-3);
+      else if (option == "--depth-scale") bt::setNumber(config, "depth.scale", number(option, text), option + " " + text);
+      else if (option == "--min-inliers") bt::setNumber(config, "ransac.min_inliers", number(option, text), option + " " + text);
+      else if (option == "--inlier-mm")
+        bt::setNumber(config, "ransac.inlier_distance", number(option, text) * 1e-3, option + " " + text);
       else if (option == "--sensor") setChoice(config, "sensor.model", option, text);
       else if (option == "--propagate-masks") config.masks = "propagated";
       else if (option == "--gpu") config.device = "gpu";
     }
+    bt::requireConsistent(config, options.config_file.empty() ? fs::path("the options") : options.config_file);
     if (print_config) {
       std::cout << bt::printConfig(config);
       return 0;

@@ -84,12 +84,43 @@ TEST_CASE("bad configuration files name the file and the key") {
   expect("tracker:\n  type: 3\n", "tracker.type = '': expected full | coarse");
   expect("graph: [1, 2\n", "not valid YAML");
   expect("graph: 3\n", "must be a section");
+  expect("graph:\n  max_keyframes: 3\n  max_keyframes: 4\n", "key 'graph.max_keyframes' is given twice");
+  expect("graph:\n  max_keyframes: 3\ndepth:\n  scale: 0.001\ngraph:\n  pool_capacity: 9\n", "section 'graph' is given twice");
+  expect("depth:\n  min_depth: 3\n  max_depth: 1\n", "depth.min_depth = 3 m is not below depth.max_depth = 1 m");
   try {
     bt::loadConfig(dir.path() / "missing.yaml");
     FAIL("no InputError");
   } catch (const bt::InputError& error) {
     CHECK(error.problem() == "file not found");
   }
+}
+
+TEST_CASE("a setting from the command line is checked as the YAML reader checks it, naming the option") {
+  const auto expect = [](const std::string& key, double value, const std::string& problem) {
+    CAPTURE(key);
+    CAPTURE(value);
+    bt::Config config;
+    try {
+      bt::setNumber(config, key, value, "--option");
+      FAIL("no InputError");
+    } catch (const bt::InputError& error) {
+      CHECK(error.source() == "--option");
+      CHECK(error.problem().find(problem) != std::string::npos);
+    }
+  };
+  expect("ransac.min_inliers", -1.0, "ransac.min_inliers = -1 is out of range [3, 100000]");
+  expect("ransac.min_inliers", 2.5, "must be a whole number");
+  expect("ransac.min_inliers", 1e12, "out of range");  // once an undefined float-to-int conversion
+  expect("ransac.inlier_distance", 0.0, "ransac.inlier_distance = 0 is out of range");
+  expect("ransac.inlier_distance", -0.001, "out of range");
+  expect("features.type", 1.0, "is a choice");
+  expect("ransac.no_such_key", 1.0, "unknown setting 'ransac.no_such_key'");
+  bt::Config config;
+  bt::setNumber(config, "ransac.min_inliers", 7.0, "--min-inliers 7");
+  CHECK(config.tracking.min_inliers == 7);
+  config.sequence.frame.depth_filter.min_depth = 2.0f;
+  config.sequence.frame.depth_filter.max_depth = 2.0f;
+  CHECK_THROWS_AS(bt::requireConsistent(config, "--option"), bt::InputError);
 }
 
 TEST_CASE("the README's settings table is the one bundletrack_track --print-config-table prints") {

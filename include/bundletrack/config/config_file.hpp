@@ -41,23 +41,24 @@ inline std::string valueText(const ConfigEntry& entry) {
       entry.value);
 }
 
-/// Sets a numeric entry from a YAML node, checking type and range.
-inline void setNumber(const ConfigEntry& entry, const cv::FileNode& node, const std::filesystem::path& path) {
+/// Sets a numeric entry to `value`, checking that an integer setting gets a whole number and that
+/// the value is in range; `source` (a file, or a command-line option) names it in the error.
+inline void assignNumber(const ConfigEntry& entry, double value, const std::filesystem::path& source) {
   const std::string name = entry.name();
-  if (!node.isInt() && !node.isReal()) throw InputError(path, name + " must be a number");
-  const double value = node.isInt() ? double(int(node)) : double(node);
   std::visit(
       [&](const auto& target) {
         using T = std::decay_t<decltype(target)>;
-        if constexpr (!std::is_same_v<T, ConfigChoice>) {
+        if constexpr (std::is_same_v<T, ConfigChoice>) {
+          throw InputError(source, name + " is a choice (" + target.alternatives() + "), not a number");
+        } else {
           using N = std::remove_pointer_t<T>;
-          if (!std::is_floating_point_v<N> && node.isReal() && value != std::floor(value))
-            throw InputError(path, name + " must be a whole number");
+          if (!std::is_floating_point_v<N> && value != std::floor(value))
+            throw InputError(source, name + " must be a whole number");
           if (!(value >= entry.min && value <= entry.max)) {
             std::ostringstream range;
             range << name << " = " << value << " is out of range [" << entry.min << ", " << entry.max << "]"
                   << (*entry.unit ? std::string(" ") + entry.unit : "");
-            throw InputError(path, range.str());
+            throw InputError(source, range.str());
           }
           *target = static_cast<N>(value);
         }
@@ -65,11 +66,38 @@ inline void setNumber(const ConfigEntry& entry, const cv::FileNode& node, const 
       entry.value);
 }
 
+/// Sets a numeric entry from a YAML node.
+inline void setNumber(const ConfigEntry& entry, const cv::FileNode& node, const std::filesystem::path& path) {
+  if (!node.isInt() && !node.isReal()) throw InputError(path, entry.name() + " must be a number");
+  assignNumber(entry, node.isInt() ? double(int(node)) : double(node), path);
+}
+
 }  // namespace detail
 
+/// Sets the numeric setting `key` (section.key) to `value` as the YAML reader would, checking
+/// whole numbers and range; `source` (e.g. the command-line option) names it in the InputError.
+inline void setNumber(Config& config, const std::string& key, double value, const std::string& source) {
+  const std::vector<ConfigEntry> entries = configEntries(config);
+  const auto entry = std::find_if(entries.begin(), entries.end(), [&](const ConfigEntry& e) { return e.name() == key; });
+  if (entry == entries.end()) throw InputError(source, "unknown setting '" + key + "'");
+  detail::assignNumber(*entry, value, source);
+}
+
+/// Settings that are valid one by one but not together; `source` names where they came from.
+inline void requireConsistent(const Config& config, const std::filesystem::path& source) {
+  const auto& depth = config.sequence.frame.depth_filter;
+  if (!(depth.min_depth < depth.max_depth)) {
+    std::ostringstream problem;
+    problem << "depth.min_depth = " << depth.min_depth << " m is not below depth.max_depth = " << depth.max_depth
+            << " m: every reading would be invalid";
+    throw InputError(source, problem.str());
+  }
+}
+
 /// Reads a YAML configuration (section: { key: value } as in configEntries) over the defaults.
-/// An unknown key, a value that is not a number, a non-integer for an integer setting, a value
-/// out of range or a name that is not among a choice's is an InputError naming the file and key.
+/// An unknown key, a key or section given twice, a value that is not a number, a non-integer for
+/// an integer setting, a value out of range, a name that is not among a choice's or settings that
+/// contradict each other (requireConsistent) is an InputError naming the file and key.
 inline Config loadConfig(const std::filesystem::path& path) {
   std::ifstream in(path);
   if (!in) throw InputError(path, std::filesystem::exists(path) ? "cannot open file" : "file not found");
@@ -87,10 +115,18 @@ inline Config loadConfig(const std::filesystem::path& path) {
   const std::vector<ConfigEntry> entries = configEntries(config);
   const cv::FileNode root = storage.root();
   if (!root.isMap() && !root.empty()) throw InputError(path, "expected sections of key: value pairs");
+  std::vector<std::string> seen_sections, seen_keys;
+  const auto once = [&](std::vector<std::string>& seen, const std::string& name, const char* what) {
+    if (std::find(seen.begin(), seen.end(), name) != seen.end())
+      throw InputError(path, std::string(what) + " '" + name + "' is given twice (which one is meant?)");
+    seen.push_back(name);
+  };
   for (const cv::FileNode section : root) {
     if (!section.isMap()) throw InputError(path, "'" + section.name() + "' must be a section of key: value pairs");
+    once(seen_sections, section.name(), "section");
     for (const cv::FileNode node : section) {
       const std::string name = section.name() + "." + node.name();
+      once(seen_keys, name, "key");
       const auto entry = std::find_if(entries.begin(), entries.end(), [&](const ConfigEntry& e) { return e.name() == name; });
       if (entry == entries.end()) throw InputError(path, "unknown key '" + name + "'");
       if (const auto* choice = std::get_if<ConfigChoice>(&entry->value)) {
@@ -103,6 +139,7 @@ inline Config loadConfig(const std::filesystem::path& path) {
       }
     }
   }
+  requireConsistent(config, path);
   return config;
 }
 
