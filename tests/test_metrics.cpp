@@ -1,8 +1,10 @@
 // Pose metrics against values computed by hand and brute force.
 #include <doctest/doctest.h>
 
+#include <cmath>
 #include <random>
 
+#include "bundletrack/eval/score_table.hpp"
 #include "bundletrack/eval/sequence_score.hpp"
 
 namespace bt = bundletrack;
@@ -37,14 +39,16 @@ TEST_CASE("ADD, ADD-S and pose errors on a symmetric model") {
   CHECK(bt::rotationErrorDeg(truth, turned) == doctest::Approx(30.0));
 }
 
-TEST_CASE("k-d tree nearest neighbour equals brute force") {
+TEST_CASE("k-d tree nearest neighbour equals brute force, near the cloud and far from it") {
   std::mt19937 rng(6);
   std::uniform_real_distribution<float> u(-0.1f, 0.1f);
   std::vector<Eigen::Vector3f> points(3000);
   for (auto& p : points) p = Eigen::Vector3f(u(rng), u(rng), u(rng));
   const bt::KdTree3 tree(points);
-  for (int q = 0; q < 300; ++q) {
-    const Eigen::Vector3f query(u(rng) * 1.5f, u(rng) * 1.5f, u(rng) * 1.5f);
+  for (int q = 0; q < 600; ++q) {
+    // Half the queries within 1.5 times the cloud, half up to 2 m away (a wrong pose scored).
+    const float reach = q < 300 ? 1.5f : 20.0f;
+    const Eigen::Vector3f query(u(rng) * reach, u(rng) * reach, u(rng) * reach);
     float best = std::numeric_limits<float>::max();
     for (const auto& p : points) best = std::min(best, (p - query).squaredNorm());
     REQUIRE(tree.nearestSquaredDistance(query) == best);
@@ -78,4 +82,13 @@ TEST_CASE("frames without an estimate count as failures") {
   CHECK(score.deg5cm5 == doctest::Approx(50.0));
   CHECK(score.iou25 == doctest::Approx(50.0));
   CHECK(score.rotation_error_deg == 0.0);  // mean over the frames that have a pose
+  // No pose at all: every rate 0, the mean errors not a number (printed n/a, JSON null), not 0.
+  const bt::SequenceScore none = bt::scoreSequence(model, truth, std::vector<std::optional<bt::SE3d>>(4));
+  CHECK(none.missing == 4);
+  CHECK(none.adds_auc == 0.0);
+  CHECK(std::isnan(none.rotation_error_deg));
+  CHECK(std::isnan(none.translation_error_cm));
+  const std::string table = bt::formatScoreTable({{"none", none}});
+  CHECK(table.find("n/a") != std::string::npos);
+  CHECK(table.find("0.00dg") == std::string::npos);
 }

@@ -37,10 +37,17 @@ inline std::string formatScoreTable(const std::vector<NamedScore>& rows) {
   std::snprintf(line, sizeof(line), "%-24s %7s %7s %8s %7s %8s %8s %7s %8s\n", "sequence", "ADD", "ADD-S", "5deg5cm",
                 "IoU25", "R_err", "T_err", "frames", "missing");
   out += line;
+  // A mean error over no frame is not a number: n/a, not 0.
+  const auto error = [](double value, const char* unit) {
+    char text[32];
+    if (std::isfinite(value)) std::snprintf(text, sizeof(text), "%6.2f%s", value, unit);
+    else std::snprintf(text, sizeof(text), "%8s", "n/a");
+    return std::string(text);
+  };
   const auto row = [&](const std::string& name, const SequenceScore& s) {
-    std::snprintf(line, sizeof(line), "%-24s %7.2f %7.2f %7.1f%% %6.1f%% %6.2fdg %6.2fcm %7d %8d\n", name.c_str(),
-                  s.add_auc, s.adds_auc, s.deg5cm5, s.iou25, s.rotation_error_deg, s.translation_error_cm, s.frames,
-                  s.missing);
+    std::snprintf(line, sizeof(line), "%-24s %7.2f %7.2f %7.1f%% %6.1f%% %s %s %7d %8d\n", name.c_str(), s.add_auc,
+                  s.adds_auc, s.deg5cm5, s.iou25, error(s.rotation_error_deg, "dg").c_str(),
+                  error(s.translation_error_cm, "cm").c_str(), s.frames, s.missing);
     out += line;
   };
   for (const auto& r : rows) row(r.sequence, r.score);

@@ -15,8 +15,8 @@ struct SequenceScore {
   double adds_auc = 0.0;  ///< ADD-S AUC on [0, 10 cm], x100
   double deg5cm5 = 0.0;  ///< % of frames with rotation error < 5 deg and translation error < 5 cm
   double iou25 = 0.0;  ///< % of frames whose posed model boxes overlap by IoU > 25%
-  double rotation_error_deg = 0.0;  ///< mean over frames with a pose
-  double translation_error_cm = 0.0;  ///< mean over frames with a pose
+  double rotation_error_deg = 0.0;  ///< mean over frames with a pose (NaN when none has one)
+  double translation_error_cm = 0.0;  ///< mean over frames with a pose (NaN when none has one)
   double final_add_cm = 0.0;  ///< ADD of the last frame: the drift at the end (inf when it has no pose)
   int frames = 0;
   int missing = 0;  ///< frames without an estimate: failures for every rate and AUC above
@@ -50,7 +50,8 @@ inline SequenceScore scoreSequence(const std::vector<Eigen::Vector3f>& model, co
     score.translation_error_cm += 100.0 * t;
     ++present;
   }
-  if (present > 0) score.rotation_error_deg /= present, score.translation_error_cm /= present;
+  score.rotation_error_deg = present > 0 ? score.rotation_error_deg / present : std::numeric_limits<double>::quiet_NaN();
+  score.translation_error_cm = present > 0 ? score.translation_error_cm / present : std::numeric_limits<double>::quiet_NaN();
   score.add_auc = areaUnderCurve(add);
   score.adds_auc = areaUnderCurve(adds);
   score.deg5cm5 = 100.0 * good / double(truth.size());
