@@ -51,6 +51,10 @@ const char* const kUsage = R"(usage: bundletrack_track --sequence DIR --out DIR 
   --viz              write OUT/overlay.mp4 (pose axes, object box, mask outline per frame; an image
                      strip OUT/overlay_strip.png always, and in place of the video where no encoder
                      is available) and, with ground truth, OUT/errors.png (errors over time)
+  --strict           a later frame that cannot be read (file missing or undecodable, depth without
+                     a reading, no mask with given masks, no annotated pose) stops the run; by
+                     default it is reported lost with the reason (track.csv: problem) and the run
+                     goes on, the frame scored as a failure (without an annotated pose: not scored)
   --quiet            no progress line
 )";
 
@@ -84,6 +88,7 @@ struct Options {
   fs::path sequence, out, config_file;
   bt::Config config;
   bool quiet = false;
+  bool strict = false;  ///< --strict: a frame that cannot be read stops the run
   bool viz = false;
 };
 
@@ -140,6 +145,14 @@ double median(std::vector<double> values) {
   return values[values.size() / 2];
 }
 
+/// A CSV field: quoted, with inner quotes doubled, when it holds a comma, a quote or a line break.
+std::string csvField(const std::string& text) {
+  if (text.find_first_of(",\"\n") == std::string::npos) return text;
+  std::string quoted = "\"";
+  for (const char c : text) quoted += c == '"' ? std::string("\"\"") : std::string(1, c);
+  return quoted + "\"";
+}
+
 int run(bt::AnyTracker& tracker, const bt::io::YcbineoatSequence& sequence, const Options& options) {
   fs::create_directories(options.out / "poses");
   if (options.config.masks == "propagated") fs::create_directories(options.out / "masks");
@@ -147,9 +160,12 @@ int run(bt::AnyTracker& tracker, const bt::io::YcbineoatSequence& sequence, cons
   const bool scored = sequence.hasGroundTruth() && sequence.hasModel();
   const bool propagated = options.config.masks == "propagated";
   csv << "frame,status,keypoints,matches,inliers,read_ms,mask_ms,features_ms,matching_ms,ransac_ms,graph_ms,solve_ms,total_ms"
-      << (scored ? ",rotation_error_deg,translation_error_cm" : "") << (propagated ? ",mask_iou\n" : "\n");
-  std::vector<bt::SE3d> truth, estimate;
-  int lost = 0;
+      << (scored ? ",rotation_error_deg,translation_error_cm" : "") << (propagated ? ",mask_iou" : "") << ",problem\n";
+  std::vector<bt::SE3d> truth;
+  std::vector<std::optional<bt::SE3d>> estimate;  // none: the frame could not be read, a failure for the scores
+  int lost = 0, unreadable = 0, unscored = 0;
+  std::string first_unreadable;
+  bt::SE3d last_pose;  // what a frame that cannot be read reports
   const bool interactive = isatty(fileno(stderr));
   std::optional<OverlayWriter> overlay;
   if (options.viz) overlay.emplace(options.out, sequence);
@@ -160,45 +176,80 @@ int run(bt::AnyTracker& tracker, const bt::io::YcbineoatSequence& sequence, cons
   bt::Stopwatch whole_run;
   for (std::size_t i = 0; i < sequence.size(); ++i) {
     bt::Stopwatch reading;
-    bt::RawFrame raw = files.next();
-    const cv::Mat dataset_mask = raw.mask;
-    if (propagated && i > 0) raw.mask = cv::Mat();  // the tracker must not see it
-    if (!propagated && i > 0 && raw.mask.empty())
-      throw bt::InputError(options.sequence / "masks" / (raw.name + ".png"),
-                           "file not found: tracking with given masks needs a mask for every frame "
-                           "(or use --propagate-masks)");
-    const cv::Rect region = tracker.regionOfInterest(raw.color.size(), raw.mask);
-    bt::RgbdFrame frame = sequence.preprocess(std::move(raw), region);
+    // A frame whose files cannot be read (or, with given masks, has no mask) is reported lost with
+    // the reason and keeps the last pose; the run goes on. Not so for the first frame, nor with --strict.
+    std::optional<bt::RgbdFrame> frame;
+    cv::Mat dataset_mask;
+    std::string problem;
+    try {
+      bt::RawFrame raw = files.next();
+      dataset_mask = raw.mask;
+      if (propagated && i > 0) raw.mask = cv::Mat();  // the tracker must not see it
+      if (!propagated && i > 0 && raw.mask.empty())
+        throw bt::InputError(sequence.maskPath(i), "file not found: tracking with given masks needs a mask for "
+                                                   "every frame (or use --propagate-masks)");
+      const cv::Rect region = tracker.regionOfInterest(raw.color.size(), raw.mask);
+      frame = sequence.preprocess(std::move(raw), region);
+    } catch (const bt::InputError& error) {
+      if (i == 0 || options.strict) throw;
+      problem = error.what();
+    }
     const double read_ms = reading.lap();
-    const bt::SE3d initial = sequence.hasGroundTruth() ? sequence.groundTruthPose(0) : bt::SE3d();
-    const bt::TrackResult result = i == 0 ? tracker.initialize(frame, initial) : tracker.track(frame);
+    const std::string name = sequence.frameNames()[i];
+    bt::TrackResult result;
+    if (frame) {
+      const bt::SE3d initial = sequence.hasGroundTruth() ? sequence.groundTruthPose(0) : bt::SE3d();
+      result = i == 0 ? tracker.initialize(*frame, initial) : tracker.track(*frame);
+    } else {
+      result.T_cam_obj = last_pose;
+      result.status = bt::TrackStatus::Lost;
+      if (unreadable++ == 0) first_unreadable = problem;
+      if (!options.quiet) std::fprintf(stderr, "%sframe %s lost: %s\n", interactive ? "\n" : "", name.c_str(), problem.c_str());
+    }
+    last_pose = result.T_cam_obj;
     if (i == 0) whole_run.lap();  // the whole run's time counts from the first tracked frame
     lost += result.status == bt::TrackStatus::Lost;
-    bt::io::writePose(options.out / "poses" / (frame.name + ".txt"), result.T_cam_obj);
+    bt::io::writePose(options.out / "poses" / (name + ".txt"), result.T_cam_obj);
     const auto& t = result.timings;
-    if (i > 0) total_ms.push_back(t.total), read_ms_all.push_back(read_ms), features_ms.push_back(t.features);
-    csv << frame.name << ',' << bt::statusName(result.status) << ',' << result.keypoints << ',' << result.matches << ','
+    if (i > 0 && frame) total_ms.push_back(t.total), read_ms_all.push_back(read_ms), features_ms.push_back(t.features);
+    csv << name << ',' << bt::statusName(result.status) << ',' << result.keypoints << ',' << result.matches << ','
         << result.inliers << ',' << read_ms << ',' << t.mask << ',' << t.features << ',' << t.matching << ',' << t.ransac << ',' << t.graph
         << ',' << t.solve << ',' << t.total;
     if (scored) {
-      truth.push_back(sequence.groundTruthPose(i));
-      estimate.push_back(result.T_cam_obj);
-      rotation_errors.push_back(bt::rotationErrorDeg(truth.back(), estimate.back()));
-      translation_errors.push_back(100.0 * bt::translationError(truth.back(), estimate.back()));
-      csv << ',' << rotation_errors.back() << ',' << translation_errors.back();
+      // A frame without an annotated pose is not scored; one that could not be read scores as a failure.
+      std::optional<bt::SE3d> true_pose;
+      try {
+        true_pose = sequence.groundTruthPose(i);
+      } catch (const bt::InputError& error) {
+        if (i == 0 || options.strict) throw;
+        ++unscored;
+        if (problem.empty()) problem = std::string(error.what()) + " (frame not scored)";
+      }
+      csv << ',';
+      if (true_pose) {
+        truth.push_back(*true_pose);
+        estimate.push_back(frame ? std::optional(result.T_cam_obj) : std::nullopt);
+        rotation_errors.push_back(bt::rotationErrorDeg(*true_pose, result.T_cam_obj));
+        translation_errors.push_back(100.0 * bt::translationError(*true_pose, result.T_cam_obj));
+        csv << rotation_errors.back() << ',' << translation_errors.back();
+      } else {
+        csv << ',';
+      }
     }
     if (propagated) {
       // A frame lost before a mask was made counts as an empty mask.
-      const cv::Mat used = result.mask.empty() ? cv::Mat::zeros(frame.depth.size(), CV_8UC1) : result.mask;
-      const fs::path mask_path = options.out / "masks" / (frame.name + ".png");
+      const cv::Mat used = result.mask.empty() ? cv::Mat::zeros(sequence.imageSize(), CV_8UC1) : result.mask;
+      const fs::path mask_path = options.out / "masks" / (name + ".png");
       if (!cv::imwrite(mask_path.string(), used)) throw bt::InputError(mask_path, "cannot write image");
       if (!dataset_mask.empty()) mask_ious.push_back(bt::maskIoU(used > 0, dataset_mask > 0));
       csv << ',';
       if (!dataset_mask.empty()) csv << mask_ious.back();
     }
-    frame.mask = result.mask;  // the overlay outlines the mask the tracker used
-    if (overlay) overlay->add(i, frame, result);
-    csv << '\n';
+    if (frame && overlay) {
+      frame->mask = result.mask;  // the overlay outlines the mask the tracker used
+      overlay->add(i, *frame, result);
+    }
+    csv << ',' << csvField(problem) << '\n';
     // On a terminal one line updated in place; in a log a line every 50 frames.
     if (!options.quiet && (interactive || (i + 1) % 50 == 0 || i + 1 == sequence.size()))
       std::fprintf(stderr, "%sframe %zu/%zu  %-7s  inliers %3d/%-3d  %.1f ms%s", interactive ? "\r" : "", i + 1,
@@ -209,6 +260,10 @@ int run(bt::AnyTracker& tracker, const bt::io::YcbineoatSequence& sequence, cons
   if (!options.quiet && interactive) std::fprintf(stderr, "\n");
   std::printf("%s: %zu frames, %d lost; poses in %s\n", options.sequence.string().c_str(), sequence.size(), lost,
               (options.out / "poses").string().c_str());
+  if (unreadable > 0)
+    std::printf("%d of the lost frames could not be read (first: %s); the reasons are in track.csv's problem column\n",
+                unreadable, first_unreadable.c_str());
+  if (unscored > 0) std::printf("%d frames without an annotated pose were not scored\n", unscored);
   if (!total_ms.empty()) {
     const double tracking = median(total_ms);
     std::printf("median per frame: %.1f ms tracking (%.1f fps; keypoint detection %.1f ms of it), %.1f ms waiting "
@@ -267,6 +322,7 @@ int main(int argc, char** argv) {
       overrides.emplace_back(arg, value());
     else if (arg == "--propagate-masks" || arg == "--gpu") overrides.emplace_back(arg, "");
     else if (arg == "--quiet") options.quiet = true;
+    else if (arg == "--strict") options.strict = true;
     else if (arg == "--viz") options.viz = true;
     else if (arg == "--help" || arg == "-h") {
       std::cout << kUsage;

@@ -1,0 +1,38 @@
+#!/usr/bin/env bash
+# One bad frame never loses a whole run: a sequence whose frame 3 has a truncated depth file, frame
+# 5 no annotated pose, frame 7 no mask and frame 9 a truncated colour file is tracked to the end;
+# the three unreadable frames are reported lost with their reason and scored as failures, frame 5
+# is tracked but not scored; with --strict the first bad file stops the run, naming it.
+# Usage: bad_frames.sh BUNDLETRACK_SYNTH BUNDLETRACK_TRACK WORK_DIR
+set -euo pipefail
+synth=$1 track=$2 work=$3
+fail() { echo "FAILED: $*" >&2; exit 1; }
+rm -rf "$work" && mkdir -p "$work"
+"$synth" --out "$work/seq" --frames 12 > /dev/null
+head -c 200 "$work/seq/depth/000003.png" > "$work/cut" && mv "$work/cut" "$work/seq/depth/000003.png"
+rm "$work/seq/annotated_poses/000005.txt" "$work/seq/masks/000007.png"
+head -c 200 "$work/seq/rgb/000009.png" > "$work/cut" && mv "$work/cut" "$work/seq/rgb/000009.png"
+
+"$track" --sequence "$work/seq" --out "$work/out" --quiet > "$work/summary.txt" 2> "$work/stderr.txt" \
+  || fail "exit status $? without --strict: $(cat "$work/stderr.txt")"
+[ "$(ls "$work/out/poses" | wc -l)" -eq 12 ] || fail "not one pose per frame"
+grep -q "12 frames, 3 lost" "$work/summary.txt" || fail "summary: $(head -1 "$work/summary.txt")"
+grep -q "3 of the lost frames could not be read" "$work/summary.txt" || fail "no count of unreadable frames"
+grep -q "1 frames without an annotated pose were not scored" "$work/summary.txt" || fail "no count of unscored frames"
+# 11 frames scored, the 3 unreadable ones as missing estimates.
+grep -Eq "^seq +[0-9.]+ +[0-9.]+ .* 11 +3$" "$work/summary.txt" || fail "score row: $(grep '^seq' "$work/summary.txt")"
+csv=$work/out/track.csv
+row() { grep "^$1," "$csv"; }
+row 000003 | grep -q ",lost,.*depth/000003.png: .*" || fail "frame 3: $(row 000003)"
+row 000007 | grep -q ",lost,.*masks/000007.png: file not found" || fail "frame 7: $(row 000007)"
+row 000009 | grep -q ",lost,.*rgb/000009.png: cannot decode image" || fail "frame 9: $(row 000009)"
+row 000005 | grep -q ",tracked,.*annotated_poses/000005.txt: file not found (frame not scored)" || fail "frame 5: $(row 000005)"
+[ "$(grep -c ',lost,' "$csv")" -eq 3 ] || fail "lost frames in track.csv: $(grep -c ',lost,' "$csv")"
+# A lost frame keeps the last good pose.
+cmp -s "$work/out/poses/000002.txt" "$work/out/poses/000003.txt" || fail "frame 3 does not keep frame 2's pose"
+
+if "$track" --sequence "$work/seq" --out "$work/strict" --quiet --strict > /dev/null 2> "$work/strict.txt"; then
+  fail "--strict did not stop at the bad depth file"
+fi
+grep -q "depth/000003.png" "$work/strict.txt" || fail "--strict error: $(cat "$work/strict.txt")"
+echo "bad frames: lost with their reasons, run completed; --strict stops at the first"
