@@ -158,6 +158,9 @@ int run(bt::AnyTracker& tracker, const bt::io::YcbineoatSequence& sequence, cons
   if (options.config.masks == "propagated") fs::create_directories(options.out / "masks");
   std::ofstream csv(options.out / "track.csv");
   const bool scored = sequence.hasGroundTruth() && sequence.hasModel();
+  // Read before the work: a model that cannot be read (empty, not numbers) stops the run now, not
+  // after every frame was tracked.
+  const std::vector<Eigen::Vector3f> model = scored ? sequence.modelPoints() : std::vector<Eigen::Vector3f>();
   const bool propagated = options.config.masks == "propagated";
   csv << "frame,status,keypoints,matches,inliers,read_ms,mask_ms,features_ms,matching_ms,ransac_ms,graph_ms,solve_ms,total_ms"
       << (scored ? ",rotation_error_deg,translation_error_cm" : "") << (propagated ? ",mask_iou" : "") << ",problem\n";
@@ -280,7 +283,7 @@ int run(bt::AnyTracker& tracker, const bt::io::YcbineoatSequence& sequence, cons
                 sum / double(mask_ious.size()), *std::min_element(mask_ious.begin(), mask_ious.end()), mask_ious.size());
   }
   if (scored) {
-    const bt::SequenceScore score = bt::scoreSequence(sequence.modelPoints(), truth, estimate);
+    const bt::SequenceScore score = bt::scoreSequence(model, truth, estimate);
     std::printf("%s", bt::formatScoreTable({{options.sequence.filename().string(), score}}).c_str());
     std::printf("final-frame ADD %.2f cm\n", score.final_add_cm);
   }

@@ -2,7 +2,8 @@
 # One bad frame never loses a whole run: a sequence whose frame 3 has a truncated depth file, frame
 # 5 no annotated pose, frame 7 no mask and frame 9 a truncated colour file is tracked to the end;
 # the three unreadable frames are reported lost with their reason and scored as failures, frame 5
-# is tracked but not scored; with --strict the first bad file stops the run, naming it.
+# is tracked but not scored; with --strict the first bad file stops the run, naming it. An empty
+# model (needed only for the scores) stops the run before any frame is tracked.
 # Usage: bad_frames.sh BUNDLETRACK_SYNTH BUNDLETRACK_TRACK WORK_DIR
 set -euo pipefail
 synth=$1 track=$2 work=$3
@@ -35,4 +36,11 @@ if "$track" --sequence "$work/seq" --out "$work/strict" --quiet --strict > /dev/
   fail "--strict did not stop at the bad depth file"
 fi
 grep -q "depth/000003.png" "$work/strict.txt" || fail "--strict error: $(cat "$work/strict.txt")"
-echo "bad frames: lost with their reasons, run completed; --strict stops at the first"
+
+: > "$work/seq/model/points.xyz"
+if "$track" --sequence "$work/seq" --out "$work/no_model" --quiet > /dev/null 2> "$work/no_model.txt"; then
+  fail "an empty model/points.xyz was accepted"
+fi
+grep -q "model/points.xyz: no points" "$work/no_model.txt" || fail "empty model: $(cat "$work/no_model.txt")"
+[ "$(ls "$work/no_model/poses" 2> /dev/null | wc -l)" -eq 0 ] || fail "frames were tracked before the model was read"
+echo "bad frames: lost with their reasons, run completed; --strict stops at the first; an empty model stops it first"
