@@ -1,13 +1,15 @@
 // bundletrack_eval --sequence DIR --poses DIR [--sequence DIR --poses DIR ...] [--json FILE]
 // Scores pose files (<poses>/<frame name>.txt, 4x4 T_cam_obj) against each sequence's
 // annotated_poses/ and model/points.xyz; prints one row per sequence and their mean. A frame
-// without a pose file is a failure, never skipped.
+// without a pose file is a failure, never skipped; one without an annotated pose is not scored.
 #include <filesystem>
 #include <iostream>
 #include <optional>
 #include <string>
 
 #include "bundletrack/eval/score_table.hpp"
+#include "bundletrack/io/point_files.hpp"
+#include "bundletrack/io/pose_files.hpp"
 #include "bundletrack/io/ycbineoat_sequence.hpp"
 
 namespace bt = bundletrack;
@@ -18,19 +20,29 @@ namespace {
 const char* const kUsage =
     "usage: bundletrack_eval --sequence DIR --poses DIR [--sequence DIR --poses DIR ...] [--json FILE]\n";
 
-bt::NamedScore evaluate(const fs::path& sequence_dir, const fs::path& poses_dir) {
-  const bt::io::YcbineoatSequence sequence(sequence_dir);
-  if (!sequence.hasGroundTruth()) throw bt::InputError(sequence_dir / "annotated_poses", "directory not found");
-  if (!sequence.hasModel()) throw bt::InputError(sequence_dir / "model" / "points.xyz", "file not found");
+/// Scoring needs only the frames' names (rgb/), the ground truth and the model: a sequence without
+/// depth/ or with an empty first mask is scored all the same. A frame without an annotated pose is
+/// not scored (counted in `unscored`).
+bt::NamedScore evaluate(const fs::path& sequence_dir, const fs::path& poses_dir, int& unscored) {
+  if (!fs::is_directory(sequence_dir)) throw bt::InputError(sequence_dir, "sequence directory not found");
+  const std::vector<std::string> names = bt::io::listColorImages(sequence_dir).names;
+  if (!fs::is_directory(sequence_dir / "annotated_poses"))
+    throw bt::InputError(sequence_dir / "annotated_poses", "directory not found");
+  const std::vector<Eigen::Vector3f> model = bt::io::readPoints(sequence_dir / "model" / "points.xyz");
   if (!fs::is_directory(poses_dir)) throw bt::InputError(poses_dir, "poses directory not found");
   std::vector<bt::SE3d> truth;
   std::vector<std::optional<bt::SE3d>> estimate;
-  for (std::size_t i = 0; i < sequence.size(); ++i) {
-    truth.push_back(sequence.groundTruthPose(i));
-    const fs::path file = poses_dir / (sequence.frameNames()[i] + ".txt");
+  for (const std::string& name : names) {
+    const fs::path true_pose = sequence_dir / "annotated_poses" / (name + ".txt");
+    if (!fs::exists(true_pose)) {
+      ++unscored;
+      continue;
+    }
+    truth.push_back(bt::io::readPose(true_pose));
+    const fs::path file = poses_dir / (name + ".txt");
     estimate.push_back(fs::exists(file) ? std::optional(bt::io::readPose(file)) : std::nullopt);
   }
-  return {sequence_dir.filename().string(), bt::scoreSequence(sequence.modelPoints(), truth, estimate)};
+  return {sequence_dir.filename().string(), bt::scoreSequence(model, truth, estimate)};
 }
 
 }  // namespace
@@ -62,8 +74,10 @@ int main(int argc, char** argv) {
   }
   try {
     std::vector<bt::NamedScore> rows;
-    for (std::size_t k = 0; k < sequences.size(); ++k) rows.push_back(evaluate(sequences[k], poses[k]));
+    int unscored = 0;
+    for (std::size_t k = 0; k < sequences.size(); ++k) rows.push_back(evaluate(sequences[k], poses[k], unscored));
     std::cout << bt::formatScoreTable(rows);
+    if (unscored > 0) std::cout << unscored << " frames without an annotated pose were not scored\n";
     if (!json.empty()) bt::writeScoreJson(json, rows);
   } catch (const std::exception& error) {
     std::cerr << "error: " << error.what() << '\n';

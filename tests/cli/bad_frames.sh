@@ -3,10 +3,11 @@
 # 5 no annotated pose, frame 7 no mask and frame 9 a truncated colour file is tracked to the end;
 # the three unreadable frames are reported lost with their reason and scored as failures, frame 5
 # is tracked but not scored; with --strict the first bad file stops the run, naming it. An empty
-# model (needed only for the scores) stops the run before any frame is tracked.
-# Usage: bad_frames.sh BUNDLETRACK_SYNTH BUNDLETRACK_TRACK WORK_DIR
+# model (needed only for the scores) stops the run before any frame is tracked. bundletrack_eval
+# scores a sequence without depth/ and masks/ as it scores the whole one.
+# Usage: bad_frames.sh BUNDLETRACK_SYNTH BUNDLETRACK_TRACK BUNDLETRACK_EVAL WORK_DIR
 set -euo pipefail
-synth=$1 track=$2 work=$3
+synth=$1 track=$2 eval=$3 work=$4
 fail() { echo "FAILED: $*" >&2; exit 1; }
 rm -rf "$work" && mkdir -p "$work"
 "$synth" --out "$work/seq" --frames 12 > /dev/null
@@ -36,6 +37,13 @@ if "$track" --sequence "$work/seq" --out "$work/strict" --quiet --strict > /dev/
   fail "--strict did not stop at the bad depth file"
 fi
 grep -q "depth/000003.png" "$work/strict.txt" || fail "--strict error: $(cat "$work/strict.txt")"
+
+cp -r "$work/seq" "$work/truth_only" && rm -r "$work/truth_only/depth" "$work/truth_only/masks"
+"$eval" --sequence "$work/seq" --poses "$work/out/poses" | sed -n 2p | cut -c25- > "$work/eval_whole.txt"
+"$eval" --sequence "$work/truth_only" --poses "$work/out/poses" | sed -n 2p | cut -c25- > "$work/eval_truth_only.txt" \
+  || fail "bundletrack_eval refused a sequence without depth/ and masks/"
+[ -s "$work/eval_whole.txt" ] && cmp -s "$work/eval_whole.txt" "$work/eval_truth_only.txt" \
+  || fail "scores differ: $(cat "$work/eval_whole.txt") / $(cat "$work/eval_truth_only.txt")"
 
 : > "$work/seq/model/points.xyz"
 if "$track" --sequence "$work/seq" --out "$work/no_model" --quiet > /dev/null 2> "$work/no_model.txt"; then

@@ -21,6 +21,46 @@ struct SequenceSettings {
   FrameSettings frame;
 };
 
+/// The frames of a sequence: its colour images (rgb/*.png, *.jpg) in name order, numeric names
+/// compared as numbers. Throws InputError without any, or for two images of one name.
+struct ColorImages {
+  std::vector<std::string> names;  ///< file stems: the frames' names
+  std::vector<std::string> files;  ///< file names in rgb/
+};
+
+inline ColorImages listColorImages(const std::filesystem::path& root) {
+  const auto numericName = [](const std::string& s) {
+    return !s.empty() && std::all_of(s.begin(), s.end(), [](unsigned char c) { return std::isdigit(c); });
+  };
+  const auto dir = root / "rgb";
+  if (!std::filesystem::is_directory(dir)) throw InputError(dir, "directory not found");
+  ColorImages found;
+  for (const auto& entry : std::filesystem::directory_iterator(dir)) {
+    std::string ext = entry.path().extension().string();
+    std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
+    if (entry.is_regular_file() && (ext == ".png" || ext == ".jpg" || ext == ".jpeg")) {
+      found.names.push_back(entry.path().stem().string());
+      found.files.push_back(entry.path().filename().string());
+    }
+  }
+  if (found.names.empty()) throw InputError(dir, "no .png or .jpg colour images");
+  std::vector<std::size_t> order(found.names.size());
+  for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
+  std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+    const std::string &x = found.names[a], &y = found.names[b];
+    if (numericName(x) && numericName(y) && x.size() != y.size()) return x.size() < y.size();
+    return x < y;
+  });
+  ColorImages sorted;
+  for (const std::size_t i : order) {
+    if (!sorted.names.empty() && sorted.names.back() == found.names[i])
+      throw InputError(dir, "two colour images share the name '" + found.names[i] + "'");
+    sorted.names.push_back(found.names[i]);
+    sorted.files.push_back(found.files[i]);
+  }
+  return sorted;
+}
+
 /// A sequence folder in the YCBInEOAT layout:
 ///   rgb/<name>.png|jpg   colour          depth/<name>.png   uint16 depth
 ///   masks/<name>.png     object mask     (the first frame's is required, later ones optional)
@@ -33,7 +73,9 @@ class YcbineoatSequence {
       : root_(std::move(root)), settings_(std::move(settings)) {
     if (!std::filesystem::is_directory(root_)) throw InputError(root_, "sequence directory not found");
     if (!(settings_.depth_scale > 0.0)) throw InputError(root_, "depth scale must be positive");
-    listColorImages();
+    ColorImages images = listColorImages(root_);
+    names_ = std::move(images.names);
+    color_files_ = std::move(images.files);
     camera_ = readIntrinsics(root_ / "cam_K.txt");
     if (!std::filesystem::is_directory(root_ / "depth")) throw InputError(root_ / "depth", "directory not found");
 
@@ -104,40 +146,6 @@ class YcbineoatSequence {
   std::vector<Eigen::Vector3f> modelPoints() const { return readPoints(modelPath()); }
 
  private:
-  static bool numericName(const std::string& s) {
-    return !s.empty() && std::all_of(s.begin(), s.end(), [](unsigned char c) { return std::isdigit(c); });
-  }
-
-  void listColorImages() {
-    const auto dir = root_ / "rgb";
-    if (!std::filesystem::is_directory(dir)) throw InputError(dir, "directory not found");
-    for (const auto& entry : std::filesystem::directory_iterator(dir)) {
-      std::string ext = entry.path().extension().string();
-      std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
-      if (entry.is_regular_file() && (ext == ".png" || ext == ".jpg" || ext == ".jpeg")) {
-        names_.push_back(entry.path().stem().string());
-        color_files_.push_back(entry.path().filename().string());
-      }
-    }
-    if (names_.empty()) throw InputError(dir, "no .png or .jpg colour images");
-    std::vector<std::size_t> order(names_.size());
-    for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
-    std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
-      const std::string &x = names_[a], &y = names_[b];
-      if (numericName(x) && numericName(y) && x.size() != y.size()) return x.size() < y.size();
-      return x < y;
-    });
-    std::vector<std::string> names, files;
-    for (const std::size_t i : order) {
-      if (!names.empty() && names.back() == names_[i])
-        throw InputError(dir, "two colour images share the name '" + names_[i] + "'");
-      names.push_back(names_[i]);
-      files.push_back(color_files_[i]);
-    }
-    names_ = std::move(names);
-    color_files_ = std::move(files);
-  }
-
   /// The commonest mistake with a new dataset is the depth unit: the object's median depth in the
   /// first frame must lie between 5 cm and 20 m, the range of any RGB-D sensor.
   void checkDepthScale(const cv::Mat& first_mask) const {
