@@ -23,6 +23,8 @@ grep -q "3 of the lost frames could not be read" "$work/summary.txt" || fail "no
 grep -q "1 frames without an annotated pose were not scored" "$work/summary.txt" || fail "no count of unscored frames"
 # 11 frames scored, the 3 unreadable ones as missing estimates.
 grep -Eq "^seq +[0-9.]+ +[0-9.]+ .* 11 +3$" "$work/summary.txt" || fail "score row: $(grep '^seq' "$work/summary.txt")"
+# A second row scores the lost frames as failures.
+grep -Eq "^seq \(lost=failed\) +[0-9.]+ +[0-9.]+ .* 11 +3$" "$work/summary.txt" || fail "no lost=failed row"
 csv=$work/out/track.csv
 row() { grep "^$1," "$csv"; }
 row 000003 | grep -q ",lost,.*depth/000003.png: .*" || fail "frame 3: $(row 000003)"

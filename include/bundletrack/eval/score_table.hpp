@@ -31,7 +31,10 @@ inline SequenceScore meanScore(const std::vector<NamedScore>& rows) {
   return mean;
 }
 
-inline std::string formatScoreTable(const std::vector<NamedScore>& rows) {
+/// Whether a table of several rows ends with their mean (not for two scorings of one run).
+enum class MeanRow { Add, Omit };
+
+inline std::string formatScoreTable(const std::vector<NamedScore>& rows, MeanRow mean = MeanRow::Add) {
   std::string out;
   char line[256];
   std::snprintf(line, sizeof(line), "%-24s %7s %7s %8s %7s %8s %8s %7s %8s\n", "sequence", "ADD", "ADD-S", "5deg5cm",
@@ -51,7 +54,7 @@ inline std::string formatScoreTable(const std::vector<NamedScore>& rows) {
     out += line;
   };
   for (const auto& r : rows) row(r.sequence, r.score);
-  if (rows.size() > 1) row("mean", meanScore(rows));
+  if (rows.size() > 1 && mean == MeanRow::Add) row("mean", meanScore(rows));
   return out;
 }
 
