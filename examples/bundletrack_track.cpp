@@ -270,12 +270,15 @@ int run(bt::AnyTracker& tracker, const bt::io::YcbineoatSequence& sequence, cons
     std::printf("%d of the lost frames could not be read (first: %s); the reasons are in track.csv's problem column\n",
                 unreadable, first_unreadable.c_str());
   if (unscored > 0) std::printf("%d frames without an annotated pose were not scored\n", unscored);
-  if (!total_ms.empty()) {
+  // Rates only where something was tracked: the time of frames that were all lost is no frame rate.
+  if (sequence.size() > 1 && lost == int(sequence.size()) - 1) {
+    std::printf("no frame after the first was tracked: no frame rate\n");
+  } else if (!total_ms.empty()) {
     const double tracking = median(total_ms);
     std::printf("median per frame: %.1f ms tracking (%.1f fps; keypoint detection %.1f ms of it), %.1f ms waiting "
                 "for its files and preprocessing it; per stage in track.csv\n",
                 tracking, 1000.0 / tracking, median(features_ms), median(read_ms_all));
-    const double per_frame = run_ms / double(total_ms.size());
+    const double per_frame = run_ms / double(sequence.size() - 1);
     std::printf("whole run after the first frame: %.1f ms per frame from the files to the poses written (%.1f fps)\n",
                 per_frame, 1000.0 / per_frame);
   }

@@ -4,7 +4,8 @@
 # the three unreadable frames are reported lost with their reason and scored as failures, frame 5
 # is tracked but not scored; with --strict the first bad file stops the run, naming it. An empty
 # model (needed only for the scores) stops the run before any frame is tracked. bundletrack_eval
-# scores a sequence without depth/ and masks/ as it scores the whole one.
+# scores a sequence without depth/ and masks/ as it scores the whole one. A run that tracks nothing
+# after the first frame prints no frame rate.
 # Usage: bad_frames.sh BUNDLETRACK_SYNTH BUNDLETRACK_TRACK BUNDLETRACK_EVAL WORK_DIR
 set -euo pipefail
 synth=$1 track=$2 eval=$3 work=$4
@@ -46,6 +47,13 @@ cp -r "$work/seq" "$work/truth_only" && rm -r "$work/truth_only/depth" "$work/tr
   || fail "bundletrack_eval refused a sequence without depth/ and masks/"
 [ -s "$work/eval_whole.txt" ] && cmp -s "$work/eval_whole.txt" "$work/eval_truth_only.txt" \
   || fail "scores differ: $(cat "$work/eval_whole.txt") / $(cat "$work/eval_truth_only.txt")"
+
+# Nothing tracked after the first frame (the object carried out of view at once): no frame rate.
+"$synth" --out "$work/gone" --frames 6 --out-of-view 1 5 > /dev/null
+"$track" --sequence "$work/gone" --out "$work/gone_out" --quiet > "$work/gone.txt" || fail "out of view: exit $?"
+grep -q "6 frames, 5 lost" "$work/gone.txt" || fail "out of view: $(head -1 "$work/gone.txt")"
+grep -q "no frame after the first was tracked" "$work/gone.txt" || fail "out of view: no notice"
+! grep -q "fps" "$work/gone.txt" || fail "a frame rate without a tracked frame: $(grep fps "$work/gone.txt")"
 
 : > "$work/seq/model/points.xyz"
 if "$track" --sequence "$work/seq" --out "$work/no_model" --quiet > /dev/null 2> "$work/no_model.txt"; then
