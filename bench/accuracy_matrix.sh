@@ -137,33 +137,41 @@ out = ["# Accuracy stress matrix", "",
 if with_before:
     out.append(f"The before columns: {before_label}, on the same sequences.")
 out.append("")
-head = "| cell | options | ADD | ADD-S | R_err | lost (in view) | ms |"
-rule = "|---|---|---|---|---|---|---|"
-if with_before:
-    head += " before: ADD | ADD-S | R_err | lost (in view) | ms |"
-    rule += "---|---|---|---|---|"
-out += [head, rule]
-for r in rows:
-    line = f"| {r['cell']} | {r['options']} | {r['ADD']} | {r['ADD-S']} | {r['R_err_deg']} | {r['lost']} ({r['lost_in_view']}) | {r['ms_per_frame']} |"
+
+
+def table(columns, before_columns, rows, row_cells, before_cells):
+    """A Markdown table of rows, with the before columns beside when there are any."""
+    head = "| " + " | ".join(columns) + " |"
+    rule = "|" + "---|" * len(columns)
     if with_before:
-        line += f" {r['before_ADD']} | {r['before_ADD-S']} | {r['before_R_err_deg']} | {r['before_lost']} ({r['before_lost_in_view']}) | {r['before_ms_per_frame']} |"
-    out.append(line)
+        head += " before: " + " | ".join(before_columns) + " |"
+        rule += "---|" * len(before_columns)
+    lines = [head, rule]
+    for r in rows:
+        line = "| " + " | ".join(row_cells(r)) + " |"
+        if with_before:
+            line += " " + " | ".join(before_cells(r)) + " |"
+        lines.append(line)
+    return lines
+
+
+def run_cells(prefix):
+    return lambda r: [r[prefix + "ADD"], r[prefix + "ADD-S"], r[prefix + "R_err_deg"],
+                      f"{r[prefix + 'lost']} ({r[prefix + 'lost_in_view']})", r[prefix + "ms_per_frame"]]
+
+
+out += table(["cell", "options", "ADD", "ADD-S", "R_err", "lost (in view)", "ms"],
+             ["ADD", "ADD-S", "R_err", "lost (in view)", "ms"], rows,
+             lambda r: [r["cell"], r["options"]] + run_cells("")(r), run_cells("before_"))
 out += ["", "## The mug's rotation where its handle is visible", "",
         "A mug's body is a surface of revolution: with the handle hidden, only texture constrains the",
         "rotation about its axis. Mean rotation error (degrees) over the frames where a quarter of the",
         "handle's model points are seen (bench/mug_rotation.py), and over the others; target < 5 where",
         "the handle is visible.", ""]
-head = "| cell | handle visible: frames | R_err | hidden: frames | R_err |"
-rule = "|---|---|---|---|---|"
-if with_before:
-    head += " before: visible R_err | hidden R_err |"
-    rule += "---|---|"
-out += [head, rule]
-for r in mug_rows:
-    line = f"| {r['cell']} | {r['visible_frames']} | {r['R_err_visible_deg']} | {r['hidden_frames']} | {r['R_err_hidden_deg']} |"
-    if with_before:
-        line += f" {r['before_R_err_visible_deg']} | {r['before_R_err_hidden_deg']} |"
-    out.append(line)
+out += table(["cell", "handle visible: frames", "R_err", "hidden: frames", "R_err"], ["visible R_err", "hidden R_err"],
+             mug_rows,
+             lambda r: [r["cell"], r["visible_frames"], r["R_err_visible_deg"], r["hidden_frames"], r["R_err_hidden_deg"]],
+             lambda r: [r["before_R_err_visible_deg"], r["before_R_err_hidden_deg"]])
 open(sys.argv[2], "w").write("\n".join(out) + "\n")
 PY
 echo "wrote $csv_file, $mug_csv and $markdown"

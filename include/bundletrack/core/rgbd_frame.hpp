@@ -56,12 +56,6 @@ inline RgbdFrame makeFrame(std::string name, cv::Mat color, const cv::Mat& raw_d
   region = region.area() > 0 ? region & image : image;
   const NoiseScale noise(settings.sensor, camera.fx);
   RgbdFrame frame{std::move(name), std::move(color), {}, std::move(mask), {}, {}, noise, region};
-  if (region == image) {
-    frame.depth = filterDepth(raw_depth, settings.depth_filter, noise);
-    frame.points = unprojectDepth(frame.depth, camera);
-    frame.normals = estimateNormals(frame.points, settings.normal_max_depth_jump, noise);
-    return frame;
-  }
   const cv::Rect around = grownWithin(region, preprocessingReach(settings), image.size());
   PinholeCameraf shifted = camera;  // pixel (u, v) of the image is (u - around.x, v - around.y) of the crop
   shifted.cx -= float(around.x);
@@ -69,6 +63,10 @@ inline RgbdFrame makeFrame(std::string name, cv::Mat color, const cv::Mat& raw_d
   const cv::Mat depth = filterDepth(raw_depth(around), settings.depth_filter, noise);
   const cv::Mat points = unprojectDepth(depth, shifted);
   const cv::Mat normals = estimateNormals(points, settings.normal_max_depth_jump, noise);
+  if (region == image) {
+    frame.depth = depth, frame.points = points, frame.normals = normals;
+    return frame;
+  }
   const cv::Rect inside = region - around.tl();
   frame.depth = cv::Mat::zeros(image.size(), CV_32FC1);
   frame.points = cv::Mat::zeros(image.size(), CV_32FC3);

@@ -73,8 +73,7 @@ class PropagatedMasks {
                             const std::optional<SE3d>& T_guess) const {
     const cv::Rect whole({0, 0}, image);
     if (!started_ || !T_guess) return whole;
-    const cv::Size grid((image.width + grid_step_ - 1) / grid_step_, (image.height + grid_step_ - 1) / grid_step_);
-    const cv::Rect cells = cv::boundingRect(renderDepth(object.surfaces(*T_guess), *T_guess, grid) > 0.0f);
+    const cv::Rect cells = cv::boundingRect(renderDepth(object.surfaces(*T_guess), *T_guess, gridSize(image)) > 0.0f);
     if (cells.area() == 0) return whole;
     const cv::Rect pixels(cells.x * grid_step_, cells.y * grid_step_, cells.width * grid_step_, cells.height * grid_step_);
     return grownWithin(pixels, settings_.search_margin_px + settings_.growth_px + grid_step_, image);
@@ -83,7 +82,7 @@ class PropagatedMasks {
   cv::Mat searchRegion(const RgbdFrame& frame, const ObservedObject& object, const std::optional<SE3d>& T_guess) const {
     requireStarted(frame);
     if (!T_guess) return objectSizedSurfaces(frame);
-    cv::Mat silhouette = renderDepth(object.surfaces(*T_guess), *T_guess, gridSize(frame)) > 0.0f;
+    cv::Mat silhouette = renderDepth(object.surfaces(*T_guess), *T_guess, gridSize(frame.depth.size())) > 0.0f;
     const int margin = (settings_.search_margin_px + grid_step_ - 1) / grid_step_;
     cv::dilate(silhouette, silhouette, cv::getStructuringElement(cv::MORPH_ELLIPSE, {2 * margin + 1, 2 * margin + 1}));
     cv::resize(silhouette, silhouette, frame.depth.size(), 0.0, 0.0, cv::INTER_NEAREST);
@@ -93,7 +92,7 @@ class PropagatedMasks {
   cv::Mat mask(const RgbdFrame& frame, const ObservedObject& object, const SE3d& T_cam_obj) const {
     requireStarted(frame);
     cv::Mat rendered;
-    cv::resize(renderDepth(object.surfaces(T_cam_obj), T_cam_obj, gridSize(frame)), rendered, frame.depth.size(), 0.0, 0.0, cv::INTER_NEAREST);
+    cv::resize(renderDepth(object.surfaces(T_cam_obj), T_cam_obj, gridSize(frame.depth.size())), rendered, frame.depth.size(), 0.0, 0.0, cv::INTER_NEAREST);
     cv::Mat region;
     const int g = settings_.growth_px;
     cv::dilate(rendered > 0.0f, region, cv::getStructuringElement(cv::MORPH_ELLIPSE, {2 * g + 1, 2 * g + 1}));
@@ -158,8 +157,8 @@ class PropagatedMasks {
     return region;
   }
 
-  cv::Size gridSize(const RgbdFrame& frame) const {
-    return {(frame.depth.cols + grid_step_ - 1) / grid_step_, (frame.depth.rows + grid_step_ - 1) / grid_step_};
+  cv::Size gridSize(cv::Size image) const {
+    return {(image.width + grid_step_ - 1) / grid_step_, (image.height + grid_step_ - 1) / grid_step_};
   }
 
   /// Depth of the observed surfaces under T_cam_obj on the grid (z-buffer, one grid cell per
