@@ -162,12 +162,12 @@ int run(bt::AnyTracker& tracker, const bt::io::YcbineoatSequence& sequence, cons
   // after every frame was tracked.
   const std::vector<Eigen::Vector3f> model = scored ? sequence.modelPoints() : std::vector<Eigen::Vector3f>();
   const bool propagated = options.config.masks == "propagated";
-  csv << "frame,status,keypoints,matches,inliers,read_ms,mask_ms,features_ms,matching_ms,ransac_ms,graph_ms,solve_ms,total_ms"
+  csv << "frame,status,by_surface,keypoints,matches,inliers,read_ms,mask_ms,features_ms,matching_ms,ransac_ms,graph_ms,solve_ms,total_ms"
       << (scored ? ",rotation_error_deg,translation_error_cm" : "") << (propagated ? ",mask_iou" : "") << ",problem\n";
   std::vector<bt::SE3d> truth;
   std::vector<std::optional<bt::SE3d>> estimate;  // none: the frame could not be read, a failure for the scores
   std::vector<std::optional<bt::SE3d>> estimate_unless_lost;  // none also where the tracker lost the object
-  int lost = 0, unreadable = 0, unscored = 0;
+  int lost = 0, unreadable = 0, unscored = 0, by_surface = 0;
   std::string first_unreadable;
   bt::SE3d last_pose;  // what a frame that cannot be read reports
   const bool interactive = isatty(fileno(stderr));
@@ -213,10 +213,11 @@ int run(bt::AnyTracker& tracker, const bt::io::YcbineoatSequence& sequence, cons
     last_pose = result.T_cam_obj;
     if (i == 0) whole_run.lap();  // the whole run's time counts from the first tracked frame
     lost += result.status == bt::TrackStatus::Lost;
+    by_surface += result.surface_only;
     bt::io::writePose(options.out / "poses" / (name + ".txt"), result.T_cam_obj);
     const auto& t = result.timings;
     if (i > 0 && frame) total_ms.push_back(t.total), read_ms_all.push_back(read_ms), features_ms.push_back(t.features);
-    csv << name << ',' << bt::statusName(result.status) << ',' << result.keypoints << ',' << result.matches << ','
+    csv << name << ',' << bt::statusName(result.status) << ',' << result.surface_only << ',' << result.keypoints << ',' << result.matches << ','
         << result.inliers << ',' << read_ms << ',' << t.mask << ',' << t.features << ',' << t.matching << ',' << t.ransac << ',' << t.graph
         << ',' << t.solve << ',' << t.total;
     if (scored) {
@@ -270,6 +271,8 @@ int run(bt::AnyTracker& tracker, const bt::io::YcbineoatSequence& sequence, cons
     std::printf("%d of the lost frames could not be read (first: %s); the reasons are in track.csv's problem column\n",
                 unreadable, first_unreadable.c_str());
   if (unscored > 0) std::printf("%d frames without an annotated pose were not scored\n", unscored);
+  if (by_surface > 0)
+    std::printf("%d frames tracked by the dense term alone, without keypoints (features.detect: on_demand)\n", by_surface);
   // Rates only where something was tracked: the time of frames that were all lost is no frame rate.
   if (sequence.size() > 1 && lost == int(sequence.size()) - 1) {
     std::printf("no frame after the first was tracked: no frame rate\n");

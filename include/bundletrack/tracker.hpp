@@ -19,6 +19,7 @@
 #include "bundletrack/tracking/frame_context.hpp"
 #include "bundletrack/tracking/stage_clock.hpp"
 #include "bundletrack/tracking/tracker_settings.hpp"
+#include "bundletrack/verification/geometric_stability.hpp"
 #include "bundletrack/verification/pose_verifier.hpp"
 
 namespace bundletrack {
@@ -72,23 +73,26 @@ class Tracker {
     frame_index_ = 0;
     lost_streak_ = 0;
     pool_.add(makeKeyframe(0, masked, masked.mask, features, T_cam_obj, camera_, grid_step_));
-    last_ = LastGood{0, T_cam_obj, std::move(features), pool_[0].surface};
+    result.keypoints = int(features.size());
+    last_ = LastGood{0, T_cam_obj, pool_[0].surface, {0, T_cam_obj, std::move(features)}};
     result.T_cam_obj = T_cam_obj;
     result.status = TrackStatus::Tracked;
-    result.keypoints = int(last_->features.size());
     result.timings = clock_.stop();
     return result;
   }
 
   /// Paper IV, one frame: segment, keypoints, coarse pose from the last good frame (IV-B), pose
   /// graph over the selected keyframes (IV-C, IV-D), verification, keyframe admission (IV-E).
+  /// With keypoints on demand the graph first runs without the frame's keypoints.
   TrackResult track(const RgbdFrame& frame) {
     if (!last_) throw InputError("frame " + frame.name, "track() called before initialize()");
     FrameContext ctx = beginFrame(frame);
     if (!searchObject(ctx)) return lost(ctx);  // the object is out of sight
-    detectKeypoints(ctx);
-    if (!estimateCoarsePose(ctx)) return lost(ctx);
-    if (!refineCoarsePose(ctx)) return lost(ctx);
+    if (!trackBySurface(ctx)) {
+      detectKeypoints(ctx);
+      if (!estimateCoarsePose(ctx)) return lost(ctx);
+      if (!refineCoarsePose(ctx)) return lost(ctx);
+    }
     cutMaskWithFinalPose(ctx);
     admitKeyframe(ctx);
     ctx.result.timings = clock_.stop();
@@ -96,12 +100,20 @@ class Tracker {
   }
 
  private:
-  /// What the next frame is tracked from: the last frame that was not lost.
-  struct LastGood {
+  /// A frame's keypoints with the frame's id and pose.
+  struct KeypointFrame {
     int id;
     SE3d T_cam_obj;
     FrameFeatures features;
+  };
+
+  /// What the next frame is tracked from: the last frame that was not lost, and the last good
+  /// frame whose keypoints were detected (the same frame unless keypoints are detected on demand).
+  struct LastGood {
+    int id;
+    SE3d T_cam_obj;
     SurfaceGrid surface;
+    KeypointFrame keypoints;
   };
 
   FrameContext beginFrame(const RgbdFrame& frame) {
@@ -123,7 +135,27 @@ class Tracker {
   void detectKeypoints(FrameContext& ctx) {
     clock_.enter(&StageTimings::features);
     ctx.features = correspondences_.detect(ctx.masked);
+    ctx.keypoints_detected = true;
     ctx.result.keypoints = int(ctx.features.size());
+  }
+
+  /// Keypoints on demand (KeypointSchedule::OnDemand): the graph from the last good pose with the
+  /// dense term alone for the frame's edges. Its result is kept when the surface under that pose
+  /// holds every direction of the motion (geometricStability at least min_surface_stability) and
+  /// the verifier accepts it on surface evidence; otherwise the frame starts over with keypoints,
+  /// from its search region. Not after lost frames.
+  bool trackBySurface(FrameContext& ctx) {
+    if (settings_.keypoints != KeypointSchedule::OnDemand || ctx.recovering) return false;
+    const cv::Mat search_region = ctx.masked.mask;
+    ctx.coarse = {last_->T_cam_obj, false, false, Evidence::SurfaceOnly, {}};
+    if (segmentObject(ctx) && geometricStability(makeNode(ctx).surface) >= settings_.min_surface_stability) {
+      buildGraph(ctx);
+      optimiseGraph(ctx);
+      if (acceptPose(ctx)) return ctx.result.surface_only = true;
+    }
+    ctx.masked.mask = search_region;
+    ctx.result.mask = cv::Mat();
+    return false;
   }
 
   /// Matches two frames' features (gated when their relative pose is known) and registers them.
@@ -146,13 +178,14 @@ class Tracker {
   /// Paper IV-B: RANSAC with the last good frame; after lost frames, the candidates of
   /// reacquisitionCandidates.
   bool estimateCoarsePose(FrameContext& ctx) {
-    PairRegistration from_last = registerPair(last_->features, ctx.features, std::nullopt);
+    const KeypointFrame& last = last_->keypoints;
+    PairRegistration from_last = registerPair(last.features, ctx.features, std::nullopt);
     ctx.result.matches = int(from_last.matches.size());
     ctx.result.inliers = int(from_last.inliers.size());
     if (ctx.recovering) return reacquisitionCandidates(ctx, std::move(from_last));
     CoarseEstimate coarse;
     coarse.found = coarse.from_last = ctx.result.inliers >= settings_.min_inliers;
-    coarse.T_cam_obj = coarse.found ? from_last.T_second_first * last_->T_cam_obj : last_->T_cam_obj;
+    coarse.T_cam_obj = coarse.found ? from_last.T_second_first * last.T_cam_obj : last_->T_cam_obj;
     if (coarse.found) coarse.last_inliers = std::move(from_last.inliers);
     ctx.candidates.push_back(std::move(coarse));
     return true;
@@ -170,7 +203,7 @@ class Tracker {
     std::vector<std::pair<int, CoarseEstimate>> registered;
     const int last_inliers = ctx.result.inliers;
     if (last_inliers >= settings_.min_inliers)
-      registered.push_back({last_inliers, {from_last.T_second_first * last_->T_cam_obj, true, true, Evidence::Features,
+      registered.push_back({last_inliers, {from_last.T_second_first * last_->keypoints.T_cam_obj, true, true, Evidence::Features,
                                            std::move(from_last.inliers)}});
     if (last_inliers < settings_.recovery_min_inliers) {
       for (const RelocalisedPose& pose :
@@ -232,6 +265,7 @@ class Tracker {
       if (k > 0) ctx.features = detected;
       ctx.coarse = std::move(ctx.candidates[k]);
       if (!segmentObject(ctx)) continue;  // not where the coarse pose says
+      makeNode(ctx);
       buildGraph(ctx);
       optimiseGraph(ctx);
       if (acceptPose(ctx)) return true;
@@ -252,12 +286,16 @@ class Tracker {
     return true;
   }
 
+  /// The current frame as a graph node at its coarse pose, with its features.
+  const Keyframe& makeNode(FrameContext& ctx) {
+    clock_.enter(&StageTimings::graph);
+    return ctx.current = makeKeyframe(ctx.id, ctx.masked, ctx.masked.mask, std::move(ctx.features),
+                                      ctx.coarse.T_cam_obj, camera_, grid_step_);
+  }
+
   /// Paper IV-C, IV-D: the current frame and the keyframes selected for its coarse pose, all pairs.
   void buildGraph(FrameContext& ctx) {
-    clock_.enter(&StageTimings::graph);
-    ctx.current = makeKeyframe(ctx.id, ctx.masked, ctx.masked.mask, std::move(ctx.features), ctx.coarse.T_cam_obj,
-                               camera_, grid_step_);
-    const LastFrameLink last{last_->id, ctx.coarse.from_last ? &ctx.coarse.last_inliers : nullptr};
+    const LastFrameLink last{last_->keypoints.id, ctx.coarse.from_last ? &ctx.coarse.last_inliers : nullptr};
     ctx.graph = buildPoseGraph(pool_, settings_.max_keyframes, ctx.current, ctx.coarse.T_cam_obj, last, cache_,
                                [&](const Keyframe& a, const Keyframe& b, const SE3d& T_a, const SE3d& T_b) {
                                  return edgeCorrespondences(a, b, T_a, T_b);
@@ -310,15 +348,24 @@ class Tracker {
   }
 
   /// Paper IV-E: the frame joins the pool when it shows a novel view (a copy only then: the graph
-  /// is done, and the features move on to the next frame's coarse step).
+  /// is done, and the features move on to the next frame's coarse step). A keyframe carries
+  /// keypoints for later edges and re-acquisition: a frame tracked without them detects them now.
   void admitKeyframe(FrameContext& ctx) {
     clock_.enter(&StageTimings::graph);
     ctx.current.T_cam_obj = ctx.result.T_cam_obj;
     if (ctx.result.status == TrackStatus::Tracked &&
         pool_.isNovelView(ctx.result.T_cam_obj.rotation(), radians(settings_.new_keyframe_rotation_deg))) {
+      if (!ctx.keypoints_detected) {
+        detectKeypoints(ctx);
+        ctx.current.features = std::move(ctx.features);
+        clock_.enter(&StageTimings::graph);
+      }
       if (const int evicted = pool_.add(ctx.current); evicted >= 0) cache_.forget(evicted);
     }
-    last_ = LastGood{ctx.id, ctx.result.T_cam_obj, std::move(ctx.current.features), ctx.current.surface};
+    KeypointFrame keypoints = ctx.keypoints_detected
+                                  ? KeypointFrame{ctx.id, ctx.result.T_cam_obj, std::move(ctx.current.features)}
+                                  : std::move(last_->keypoints);
+    last_ = LastGood{ctx.id, ctx.result.T_cam_obj, ctx.current.surface, std::move(keypoints)};
     lost_streak_ = 0;
   }
 

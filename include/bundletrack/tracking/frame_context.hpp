@@ -29,6 +29,7 @@ struct FrameContext {
   bool recovering;  ///< the frames before were lost
   RgbdFrame masked;  ///< the frame with the mask the stages work on (shares the image buffers)
   FrameFeatures features;  ///< detected; moves into `current` when the graph is built
+  bool keypoints_detected = false;  ///< on this frame (not always with keypoints on demand)
   std::vector<CoarseEstimate> candidates;  ///< coarse poses to try, in order (several only after lost frames)
   CoarseEstimate coarse;  ///< the one being tried
   Keyframe current;  ///< the frame as a graph node

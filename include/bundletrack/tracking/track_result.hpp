@@ -37,6 +37,7 @@ struct TrackResult {
   int inliers = 0;  ///< RANSAC inliers among them
   cv::Mat mask;  ///< the object mask the frame was tracked with; empty when none was made
   StageTimings timings;
+  bool surface_only = false;  ///< tracked by the dense term alone (keypoints on demand)
 };
 
 }  // namespace bundletrack

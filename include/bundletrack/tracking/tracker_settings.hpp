@@ -7,6 +7,16 @@
 
 namespace bundletrack {
 
+/// When the tracker detects keypoints.
+enum class KeypointSchedule {
+  EveryFrame,  ///< paper IV: every frame
+  /// Only where the dense term alone cannot be trusted (Tracker::trackBySurface): a frame is first
+  /// tracked without keypoints, from the last good pose; keypoints are detected when the surface
+  /// seen is geometrically unstable, when the verifier refuses that pose, after lost frames and on
+  /// frames that become keyframes.
+  OnDemand,
+};
+
 /// What the pipeline of Tracker decides with (docs/DESIGN.md section 3; the original code's
 /// values unless noted). The policies carry their own settings.
 struct TrackerSettings {
@@ -38,6 +48,16 @@ struct TrackerSettings {
   /// good pose moved onto the object's points in this frame -- and the first whose result the
   /// verifier accepts on Evidence::SurfaceOnly is kept (0: features alone).
   int recovery_surface_candidates = 4;
+  /// OnDemand by default: on the stress matrix (bench/ACCURACY.md) it is within 0.2 ADD-S of
+  /// EveryFrame on every cell, and it skips keypoints on most frames of the shared container and
+  /// mug (bench/RESULTS.md); EveryFrame is the paper's schedule.
+  KeypointSchedule keypoints = KeypointSchedule::OnDemand;
+  /// OnDemand: the dense term alone may track a frame whose surface has at least this geometric
+  /// stability (geometricStability: lambda_min / lambda_max of its point-to-plane information).
+  /// 0.02: the weakest direction at most 7x less certain than the strongest (1 / sqrt(0.02)); a
+  /// box seen face-on (< 0.001) or a mug (its twist, 0.003-0.015 with exact normals) stays
+  /// below, three faces of a box (0.2) above.
+  double min_surface_stability = 0.02;
   GaussNewtonSettings gauss_newton;
 };
 

@@ -1,0 +1,108 @@
+// geometricStability against surfaces whose free motions are known: a plane slides and spins in
+// itself, a sphere turns about its centre, a cylinder twists about and slides along its axis;
+// three faces of a box hold every direction. Independent of where the surface sits, and the
+// normal averaging removes most of what noisy normals add to a plane.
+#include <doctest/doctest.h>
+
+#include <cmath>
+#include <functional>
+#include <random>
+
+#include "bundletrack/core/se3.hpp"
+#include "bundletrack/verification/geometric_stability.hpp"
+
+namespace bt = bundletrack;
+
+namespace {
+
+/// A size x size grid whose cell (x, y) holds surface(u, v) for u, v in [0, 1] (point, normal).
+bt::SurfaceGrid gridOf(int size, const std::function<std::pair<Eigen::Vector3d, Eigen::Vector3d>(double, double)>& surface,
+                       const bt::SE3d& placed = {}) {
+  bt::SurfaceGrid grid;
+  grid.points.create(size, size, CV_32FC3);
+  grid.normals.create(size, size, CV_32FC3);
+  for (int y = 0; y < size; ++y) {
+    for (int x = 0; x < size; ++x) {
+      auto [p, n] = surface(x / double(size - 1), y / double(size - 1));
+      p = placed * p;
+      n = placed.rotation() * n;
+      grid.points.at<cv::Vec3f>(y, x) = cv::Vec3f(float(p.x()), float(p.y()), float(p.z()));
+      grid.normals.at<cv::Vec3f>(y, x) = cv::Vec3f(float(n.x()), float(n.y()), float(n.z()));
+    }
+  }
+  bt::indexCells(grid);
+  return grid;
+}
+
+std::pair<Eigen::Vector3d, Eigen::Vector3d> plane(double u, double v) {
+  return {{0.2 * u - 0.1, 0.2 * v - 0.1, 1.0}, {0.0, 0.0, -1.0}};
+}
+
+/// A cap of a sphere of radius 0.1 around the camera's view of it.
+std::pair<Eigen::Vector3d, Eigen::Vector3d> sphere(double u, double v) {
+  const double theta = 2.0 * (u - 0.5), phi = 2.0 * (v - 0.5);  // up to +-57 degrees
+  const Eigen::Vector3d n(std::sin(theta) * std::cos(phi), std::sin(phi), -std::cos(theta) * std::cos(phi));
+  return {Eigen::Vector3d(0, 0, 1) + 0.1 * n, n};
+}
+
+/// The front half of a cylinder of radius 0.05 along y.
+std::pair<Eigen::Vector3d, Eigen::Vector3d> cylinder(double u, double v) {
+  const double theta = 3.0 * (u - 0.5);
+  const Eigen::Vector3d n(std::sin(theta), 0.0, -std::cos(theta));
+  return {Eigen::Vector3d(0, 0.2 * v - 0.1, 1.0) + 0.05 * n, n};
+}
+
+/// Three faces of a box of side 0.2, 0.8 m in front of the camera, meeting at the corner nearest
+/// to it (a third of the grid each).
+std::pair<Eigen::Vector3d, Eigen::Vector3d> boxCorner(double u, double v) {
+  const Eigen::Vector3d corner(-0.1, -0.1, 0.8);
+  const double a = 0.2 * (3.0 * u - std::floor(3.0 * std::min(u, 0.999))), b = 0.2 * v;
+  if (u < 1.0 / 3.0) return {corner + Eigen::Vector3d(a, b, 0.0), {0, 0, -1}};
+  if (u < 2.0 / 3.0) return {corner + Eigen::Vector3d(0.0, b, a), {-1, 0, 0}};
+  return {corner + Eigen::Vector3d(a, 0.0, b), {0, -1, 0}};
+}
+
+}  // namespace
+
+TEST_CASE("geometric stability: 0 where a motion is free (plane, sphere, cylinder), large for a box corner") {
+  for (const int radius : {0, 2}) {
+    CAPTURE(radius);
+    CHECK(bt::geometricStability(gridOf(40, plane), radius) < 1e-9);
+    const double corner = bt::geometricStability(gridOf(60, boxCorner), radius);
+    MESSAGE("box corner: " << corner);
+    CHECK(corner > 0.1);
+  }
+  // Exact normals: a sphere turns freely about its centre, a cylinder about its axis. Averaged
+  // ones near the rim lean inwards (a truncated neighbourhood), which holds the turn a little.
+  for (const auto& curved : {sphere, cylinder}) {
+    CHECK(bt::geometricStability(gridOf(40, curved), 0) < 1e-9);
+    CHECK(bt::geometricStability(gridOf(40, curved), 2) < 1e-3);
+  }
+  CHECK(bt::geometricStability(bt::SurfaceGrid{}) == 0.0);
+}
+
+TEST_CASE("geometric stability does not depend on where the surface is or how it is turned") {
+  const bt::SE3d placed(bt::SO3d::exp(Eigen::Vector3d(0.3, -0.7, 0.2)), Eigen::Vector3d(0.5, -0.2, 1.5));
+  const double here = bt::geometricStability(gridOf(60, boxCorner));
+  CHECK(bt::geometricStability(gridOf(60, boxCorner, placed)) == doctest::Approx(here).epsilon(1e-5));
+}
+
+TEST_CASE("noisy normals make a plane look stable, and averaging 5x5 cells removes most of it") {
+  std::mt19937 random(3);
+  std::normal_distribution<double> tilt(0.0, 0.12);  // per axis: normals about 10 degrees off
+  const auto noisy = [&](double u, double v) {
+    auto [p, n] = plane(u, v);
+    return std::pair(p, Eigen::Vector3d(tilt(random), tilt(random), -1.0).normalized());
+  };
+  const bt::SurfaceGrid grid = gridOf(60, noisy);
+  const double raw = bt::geometricStability(grid, 0), averaged = bt::geometricStability(grid, 2);
+  MESSAGE("noisy plane: " << raw << " raw, " << averaged << " averaged");
+  // In-plane translation gathers sum (n.t)^2 ~ N sigma^2 against N along the normal.
+  CHECK(raw > 0.5 * 0.12 * 0.12);
+  CHECK(averaged < raw / 10.0);
+  // Three times noisier readings: the default window is three times as wide.
+  bt::SurfaceGrid noisier = grid;
+  noisier.noise_scale = 3.0;
+  CHECK(bt::geometricStability(noisier) == bt::geometricStability(grid, 6));
+  CHECK(bt::geometricStability(grid) == averaged);
+}
