@@ -5,10 +5,13 @@
 // model, and the propagated masks' IoU when it has masks.
 #include <algorithm>
 #include <cmath>
+#include <cerrno>
 #include <cstdio>
+#include <cstring>
 #include <fstream>
 #include <iostream>
 #include <string>
+#include <system_error>
 #include <variant>
 
 #include <unistd.h>
@@ -153,9 +156,26 @@ std::string csvField(const std::string& text) {
   return quoted + "\"";
 }
 
+/// Makes OUT/poses (and OUT/masks) and checks that files can be written there, before any work:
+/// --out naming a file, a place without permission, a link loop or a name too long is said so.
+void prepareOutput(const fs::path& out, bool masks) {
+  std::error_code error;
+  const fs::file_status status = fs::status(out, error);
+  if (error && status.type() != fs::file_type::not_found)
+    throw bt::InputError(out, "--out cannot be used: " + error.message());
+  if (fs::exists(status) && !fs::is_directory(status))
+    throw bt::InputError(out, "--out names a file, not a directory (the poses, track.csv and plots go into it)");
+  for (const char* folder : {"poses", masks ? "masks" : nullptr}) {
+    if (!folder) continue;
+    fs::create_directories(out / folder, error);
+    if (error) throw bt::InputError(out / folder, "--out: cannot create the directory: " + error.message());
+  }
+  const fs::path probe = out / "poses" / ".write_test";
+  if (!std::ofstream(probe)) throw bt::InputError(out, std::string("--out is not writable: ") + std::strerror(errno));
+  fs::remove(probe, error);
+}
+
 int run(bt::AnyTracker& tracker, const bt::io::YcbineoatSequence& sequence, const Options& options) {
-  fs::create_directories(options.out / "poses");
-  if (options.config.masks == "propagated") fs::create_directories(options.out / "masks");
   std::ofstream csv(options.out / "track.csv");
   const bool scored = sequence.hasGroundTruth() && sequence.hasModel();
   // Read before the work: a model that cannot be read (empty, not numbers) stops the run now, not
@@ -366,6 +386,7 @@ int main(int argc, char** argv) {
       return 0;
     }
     if (options.sequence.empty() || options.out.empty()) fail("--sequence and --out are required");
+    prepareOutput(options.out, config.masks == "propagated");
     const bt::io::YcbineoatSequence sequence(options.sequence, config.sequence);
     const std::unique_ptr<bt::AnyTracker> tracker = bt::makeTracker(config, sequence.camera().cast<float>());
     return run(*tracker, sequence, options);

@@ -87,6 +87,8 @@ TEST_CASE("bad configuration files name the file and the key") {
   expect("graph:\n  max_keyframes: 3\n  max_keyframes: 4\n", "key 'graph.max_keyframes' is given twice");
   expect("graph:\n  max_keyframes: 3\ndepth:\n  scale: 0.001\ngraph:\n  pool_capacity: 9\n", "section 'graph' is given twice");
   expect("depth:\n  min_depth: 3\n  max_depth: 1\n", "depth.min_depth = 3 m is not below depth.max_depth = 1 m");
+  // Found by tests/fuzz (fuzz_config): OpenCV's parser threw std::length_error, not cv::Exception.
+  expect("features:\n  type: orb\n  : evtect: every_frame\n+depth:\n n_d2\n", "not valid YAML");
   try {
     bt::loadConfig(dir.path() / "missing.yaml");
     FAIL("no InputError");

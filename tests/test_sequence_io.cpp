@@ -102,12 +102,20 @@ TEST_CASE("bad input raises InputError naming the file and the problem") {
                         {"100 0 nan\n0 100 29.5\n0 0 1\n", "non-finite"},
                         {"100 0 39.5\n0 100 29.5\n", "expected 9 numbers"},
                         {"fx=100 0 39.5\n0 100 29.5\n0 0 1\n", "is not a number"},
-                        {"100 0 319.5\n0 100 239.5\n0 0 1\n", "principal point"}};
+                        {"100 0 319.5\n0 100 239.5\n0 0 1\n", "principal point"},
+                        {"1000000 0 39.5\n0 1000000 29.5\n0 0 1\n", "field of view of 0.0"},  // K of mm, not px
+                        {"0.5 0 39.5\n0 0.5 29.5\n0 0 1\n", "field of view of 17"},
+                        {"100 0 39.5\n0 10 29.5\n0 0 1\n", "fx / fy = 10"}};
   for (const auto& bad : bad_intrinsics) {
     SUBCASE(bad.problem) {
       writeText(root / "cam_K.txt", bad.text);
       checkInputError(open, root / "cam_K.txt", bad.problem);
     }
+  }
+  SUBCASE("a directory where cam_K.txt belongs") {
+    fs::remove(root / "cam_K.txt");
+    fs::create_directory(root / "cam_K.txt");
+    checkInputError(open, root / "cam_K.txt", "is a directory");
   }
   SUBCASE("missing first mask") {
     fs::remove(root / "masks" / "1.png");
@@ -120,6 +128,27 @@ TEST_CASE("bad input raises InputError naming the file and the problem") {
   SUBCASE("unreadable colour image") {
     writeText(root / "rgb" / "2.png", "not a png");
     checkInputError([&] { open().frame(1); }, root / "rgb" / "2.png", "cannot decode");
+  }
+  // Truncated files still decode (the rest grey or black) unless their end marker is checked.
+  const auto truncate = [](const fs::path& path) { fs::resize_file(path, fs::file_size(path) / 2); };
+  SUBCASE("truncated colour PNG") {
+    truncate(root / "rgb" / "2.png");
+    checkInputError([&] { open().frame(1); }, root / "rgb" / "2.png", "truncated or corrupt image");
+  }
+  SUBCASE("truncated colour JPEG") {
+    fs::remove(root / "rgb" / "2.png");
+    cv::Mat noise(60, 80, CV_8UC3);
+    cv::randu(noise, 0, 255);  // incompressible: the entropy-coded data fills the file
+    cv::imwrite((root / "rgb" / "2.jpg").string(), noise);
+    CHECK(open().frame(1).color.size() == cv::Size(80, 60));  // whole, it reads
+    truncate(root / "rgb" / "2.jpg");
+    const cv::Mat half = cv::imread((root / "rgb" / "2.jpg").string());
+    CHECK(half.size() == cv::Size(80, 60));  // what OpenCV alone returns: an image, its lower part grey
+    checkInputError([&] { open().frame(1); }, root / "rgb" / "2.jpg", "truncated or corrupt image");
+  }
+  SUBCASE("truncated depth PNG") {
+    truncate(root / "depth" / "2.png");
+    checkInputError([&] { open().frame(1); }, root / "depth" / "2.png", "truncated or corrupt image");
   }
   SUBCASE("missing depth image") {
     fs::remove(root / "depth" / "2.png");

@@ -5,7 +5,8 @@
 # is tracked but not scored; with --strict the first bad file stops the run, naming it. An empty
 # model (needed only for the scores) stops the run before any frame is tracked. bundletrack_eval
 # scores a sequence without depth/ and masks/ as it scores the whole one. A run that tracks nothing
-# after the first frame prints no frame rate.
+# after the first frame prints no frame rate. An --out that cannot take the results (a file, a link
+# loop, a name too long) and a directory where cam_K.txt belongs are refused, naming the cause.
 # Usage: bad_frames.sh BUNDLETRACK_SYNTH BUNDLETRACK_TRACK BUNDLETRACK_EVAL WORK_DIR
 set -euo pipefail
 synth=$1 track=$2 eval=$3 work=$4
@@ -30,7 +31,7 @@ csv=$work/out/track.csv
 row() { grep "^$1," "$csv"; }
 row 000003 | grep -q ",lost,.*depth/000003.png: .*" || fail "frame 3: $(row 000003)"
 row 000007 | grep -q ",lost,.*masks/000007.png: file not found" || fail "frame 7: $(row 000007)"
-row 000009 | grep -q ",lost,.*rgb/000009.png: cannot decode image" || fail "frame 9: $(row 000009)"
+row 000009 | grep -q ",lost,.*rgb/000009.png: truncated or corrupt image" || fail "frame 9: $(row 000009)"
 row 000005 | grep -q ",tracked,.*annotated_poses/000005.txt: file not found (frame not scored)" || fail "frame 5: $(row 000005)"
 [ "$(grep -c ',lost,' "$csv")" -eq 3 ] || fail "lost frames in track.csv: $(grep -c ',lost,' "$csv")"
 # A lost frame keeps the last good pose.
@@ -61,4 +62,20 @@ if "$track" --sequence "$work/seq" --out "$work/no_model" --quiet > /dev/null 2>
 fi
 grep -q "model/points.xyz: no points" "$work/no_model.txt" || fail "empty model: $(cat "$work/no_model.txt")"
 [ "$(ls "$work/no_model/poses" 2> /dev/null | wc -l)" -eq 0 ] || fail "frames were tracked before the model was read"
-echo "bad frames: lost with their reasons, run completed; --strict stops at the first; an empty model stops it first"
+
+# Output that cannot be written is refused before any work, naming --out and the cause.
+expect_error() {  # expect_error MESSAGE ARGS...: bundletrack_track exits 1 and says MESSAGE
+  local message=$1; shift
+  if "$track" "$@" --quiet > /dev/null 2> "$work/error.txt"; then fail "accepted: $*"; fi
+  grep -q -- "$message" "$work/error.txt" || fail "$*: $(cat "$work/error.txt")"
+}
+cp "$work/out/track.csv" "$work/a_file"
+expect_error "a_file: --out names a file, not a directory" --sequence "$work/gone" --out "$work/a_file"
+ln -s "$work/loop_b" "$work/loop_a" && ln -s "$work/loop_a" "$work/loop_b"
+expect_error "--out cannot be used: Too many levels of symbolic links" --sequence "$work/gone" --out "$work/loop_a"
+long=$(printf 'x%.0s' $(seq 300))
+expect_error "File name too long" --sequence "$work/gone" --out "$work/$long"
+# A directory where a file belongs.
+rm "$work/gone/cam_K.txt" && mkdir "$work/gone/cam_K.txt"
+expect_error "cam_K.txt: is a directory, expected a file" --sequence "$work/gone" --out "$work/dir_k"
+echo "bad frames: lost with their reasons, run completed; --strict stops at the first; an empty model stops it first; unusable --out refused first"

@@ -14,6 +14,7 @@
 
 #include "bundletrack/config/config.hpp"
 #include "bundletrack/core/error.hpp"
+#include "bundletrack/io/file_access.hpp"
 
 namespace bundletrack {
 
@@ -94,22 +95,20 @@ inline void requireConsistent(const Config& config, const std::filesystem::path&
   }
 }
 
-/// Reads a YAML configuration (section: { key: value } as in configEntries) over the defaults.
+/// A YAML configuration (section: { key: value } as in configEntries) over the defaults, read
+/// from `yaml`, the text of `path`.
 /// An unknown key, a key or section given twice, a value that is not a number, a non-integer for
 /// an integer setting, a value out of range, a name that is not among a choice's or settings that
 /// contradict each other (requireConsistent) is an InputError naming the file and key.
-inline Config loadConfig(const std::filesystem::path& path) {
-  std::ifstream in(path);
-  if (!in) throw InputError(path, std::filesystem::exists(path) ? "cannot open file" : "file not found");
-  std::stringstream text;
-  text << in.rdbuf();
-  std::string yaml = text.str();
+inline Config parseConfig(std::string yaml, const std::filesystem::path& path) {
   if (yaml.rfind("%YAML", 0) != 0) yaml = "%YAML:1.0\n---\n" + yaml;  // OpenCV needs the directive
   cv::FileStorage storage;
   try {
     storage.open(yaml, cv::FileStorage::READ | cv::FileStorage::MEMORY | cv::FileStorage::FORMAT_YAML);
   } catch (const cv::Exception& error) {
     throw InputError(path, "not valid YAML (" + std::string(error.err) + ")");
+  } catch (const std::exception& error) {  // OpenCV's parser lets some throw through (fuzz_config)
+    throw InputError(path, "not valid YAML (" + std::string(error.what()) + ")");
   }
   Config config;
   const std::vector<ConfigEntry> entries = configEntries(config);
@@ -141,6 +140,14 @@ inline Config loadConfig(const std::filesystem::path& path) {
   }
   requireConsistent(config, path);
   return config;
+}
+
+/// Reads a YAML configuration file (parseConfig).
+inline Config loadConfig(const std::filesystem::path& path) {
+  std::ifstream in = io::openForReading(path);
+  std::stringstream text;
+  text << in.rdbuf();
+  return parseConfig(text.str(), path);
 }
 
 /// The configuration as YAML that loadConfig reads back, each key under a comment with its

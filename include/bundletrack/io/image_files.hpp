@@ -1,13 +1,18 @@
 #pragma once
 
+#include <algorithm>
+#include <cstring>
 #include <filesystem>
+#include <iterator>
 #include <string>
+#include <vector>
 
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include "bundletrack/core/error.hpp"
+#include "bundletrack/io/file_access.hpp"
 
 namespace bundletrack::io {
 
@@ -20,20 +25,54 @@ inline std::string describeImageType(const cv::Mat& image) {
   return std::string(bits) + " with " + std::to_string(image.channels()) + " channel(s)";
 }
 
-inline cv::Mat readImage(const std::filesystem::path& path, int flags) {
-  if (!std::filesystem::is_regular_file(path)) throw InputError(path, "file not found");
-  cv::Mat image = cv::imread(path.string(), flags);
+/// Whether an encoded JPEG or PNG ends as its format requires: a JPEG with its end-of-image
+/// marker FF D9 (entropy-coded data never holds it: a 0xFF there is followed by 0x00), a PNG with
+/// its IEND chunk, either within the last 1 KiB (padding may follow). A truncated file lacks it,
+/// and decoders still return an image whose rest is grey or black. Other formats: true.
+inline bool endsComplete(const std::vector<uchar>& bytes) {
+  const auto startsWith = [&](std::initializer_list<uchar> magic) {
+    return bytes.size() >= magic.size() && std::equal(magic.begin(), magic.end(), bytes.begin());
+  };
+  const auto tailHolds = [&](std::initializer_list<uchar> marker) {
+    const auto tail = bytes.end() - std::ptrdiff_t(std::min<std::size_t>(bytes.size(), 1024));
+    return std::search(tail, bytes.end(), marker.begin(), marker.end()) != bytes.end();
+  };
+  if (startsWith({0xFF, 0xD8, 0xFF})) return tailHolds({0xFF, 0xD9});
+  if (startsWith({0x89, 'P', 'N', 'G', 0x0D, 0x0A, 0x1A, 0x0A})) return tailHolds({'I', 'E', 'N', 'D'});
+  return true;
+}
+
+/// Decodes an encoded image (the bytes of `path`); an empty, truncated or undecodable one is an
+/// InputError.
+inline cv::Mat decodeImage(const std::vector<uchar>& bytes, int flags, const std::filesystem::path& path) {
+  if (bytes.empty()) throw InputError(path, "empty file");
+  if (!endsComplete(bytes))
+    throw InputError(path, "truncated or corrupt image: it ends without its format's end marker (" +
+                               std::to_string(bytes.size()) + " bytes)");
+  cv::Mat image;
+  try {
+    image = cv::imdecode(bytes, flags);
+  } catch (const cv::Exception& error) {
+    throw InputError(path, "cannot decode image (" + std::string(error.err) + ")");
+  }
   if (image.empty()) throw InputError(path, "cannot decode image");
   return image;
+}
+
+/// Decodes an image file; a missing or unreadable file is an InputError too.
+inline cv::Mat readImage(const std::filesystem::path& path, int flags) {
+  std::ifstream in = openForReading(path, std::ios::binary);
+  const std::vector<uchar> bytes{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+  if (!in.eof() && in.fail()) throw InputError(path, std::string("cannot be read: ") + std::strerror(errno));
+  return decodeImage(bytes, flags, path);
 }
 
 /// 8-bit BGR colour.
 inline cv::Mat readColor(const std::filesystem::path& path) { return readImage(path, cv::IMREAD_COLOR); }
 
-/// Depth in metres (CV_32FC1) from a single-channel 16-bit image times `scale` (metres per unit).
-/// Only the encoding is checked here; an all-zero image is the caller's decision.
-inline cv::Mat readDepth(const std::filesystem::path& path, double scale) {
-  const cv::Mat raw = readImage(path, cv::IMREAD_UNCHANGED);
+/// Depth in metres (CV_32FC1) from a decoded single-channel 16-bit image (of `path`) times `scale`
+/// (metres per unit). Only the encoding is checked here; an all-zero image is the caller's decision.
+inline cv::Mat depthFromImage(const cv::Mat& raw, double scale, const std::filesystem::path& path) {
   if (raw.type() != CV_16UC1)
     throw InputError(path, "depth must be a single-channel 16-bit image, got " + describeImageType(raw));
   cv::Mat metres;
@@ -41,9 +80,14 @@ inline cv::Mat readDepth(const std::filesystem::path& path, double scale) {
   return metres;
 }
 
-/// Binary mask (CV_8UC1, 0 or 255): any non-zero pixel, of any channel, is on the object.
-inline cv::Mat readMask(const std::filesystem::path& path) {
-  cv::Mat raw = readImage(path, cv::IMREAD_UNCHANGED);
+/// The depth of an image file (depthFromImage).
+inline cv::Mat readDepth(const std::filesystem::path& path, double scale) {
+  return depthFromImage(readImage(path, cv::IMREAD_UNCHANGED), scale, path);
+}
+
+/// Binary mask (CV_8UC1, 0 or 255) of a decoded image: any non-zero pixel, of any channel, is on
+/// the object.
+inline cv::Mat maskFromImage(const cv::Mat& raw) {
   if (raw.channels() > 1) {
     std::vector<cv::Mat> channels;
     cv::split(raw, channels);
@@ -53,5 +97,8 @@ inline cv::Mat readMask(const std::filesystem::path& path) {
   }
   return raw != 0;
 }
+
+/// The binary mask of an image file (maskFromImage).
+inline cv::Mat readMask(const std::filesystem::path& path) { return maskFromImage(readImage(path, cv::IMREAD_UNCHANGED)); }
 
 }  // namespace bundletrack::io

@@ -9,14 +9,13 @@
 #include <Eigen/Core>
 
 #include "bundletrack/core/error.hpp"
+#include "bundletrack/io/file_access.hpp"
 
 namespace bundletrack::io {
 
-/// Reads an .xyz file: one point per line, "x y z" in metres; further columns (normals, colour)
-/// are ignored, blank lines skipped.
-inline std::vector<Eigen::Vector3f> readPoints(const std::filesystem::path& path) {
-  std::ifstream in(path);
-  if (!in) throw InputError(path, std::filesystem::exists(path) ? "cannot open file" : "file not found");
+/// The points of an .xyz text: one point per line, "x y z" in metres; further columns (normals,
+/// colour) are ignored, blank lines skipped.
+inline std::vector<Eigen::Vector3f> parsePoints(std::istream& in, const std::filesystem::path& path) {
   std::vector<Eigen::Vector3f> points;
   std::string line;
   for (int line_number = 1; std::getline(in, line); ++line_number) {
@@ -29,6 +28,12 @@ inline std::vector<Eigen::Vector3f> readPoints(const std::filesystem::path& path
   }
   if (points.empty()) throw InputError(path, "no points");
   return points;
+}
+
+/// Reads an .xyz file (parsePoints).
+inline std::vector<Eigen::Vector3f> readPoints(const std::filesystem::path& path) {
+  std::ifstream in = openForReading(path);
+  return parsePoints(in, path);
 }
 
 inline void writePoints(const std::filesystem::path& path, const std::vector<Eigen::Vector3f>& points) {

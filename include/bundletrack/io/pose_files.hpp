@@ -10,10 +10,9 @@
 
 namespace bundletrack::io {
 
-/// Reads a 4x4 homogeneous transform written row by row. The rotation block must be orthonormal
-/// with determinant +1 to 1e-3 (annotation files are printed with a few digits).
-inline SE3d readPose(const std::filesystem::path& path) {
-  const std::vector<double> v = readNumbers(path);
+/// A 4x4 homogeneous transform from its 16 numbers, row by row. The rotation block must be
+/// orthonormal with determinant +1 to 1e-3 (annotation files are printed with a few digits).
+inline SE3d poseFromNumbers(const std::vector<double>& v, const std::filesystem::path& path) {
   if (v.size() != 16) throw InputError(path, "expected 16 numbers (4x4 pose), found " + std::to_string(v.size()));
   const Eigen::Matrix<double, 4, 4, Eigen::RowMajor> T(v.data());
   if (!T.allFinite()) throw InputError(path, "pose has a non-finite entry");
@@ -24,6 +23,9 @@ inline SE3d readPose(const std::filesystem::path& path) {
     throw InputError(path, "rotation block is not a rotation matrix");
   return SE3d::fromMatrix(T);
 }
+
+/// Reads a pose file (poseFromNumbers).
+inline SE3d readPose(const std::filesystem::path& path) { return poseFromNumbers(readNumbers(path), path); }
 
 inline void writePose(const std::filesystem::path& path, const SE3d& pose) {
   std::ofstream out(path);

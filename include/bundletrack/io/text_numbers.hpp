@@ -7,13 +7,13 @@
 #include <vector>
 
 #include "bundletrack/core/error.hpp"
+#include "bundletrack/io/file_access.hpp"
 
 namespace bundletrack::io {
 
-/// All whitespace-separated numbers of a text file; a token that is not a number is an error.
-inline std::vector<double> readNumbers(const std::filesystem::path& path) {
-  std::ifstream in(path);
-  if (!in) throw InputError(path, std::filesystem::exists(path) ? "cannot open file" : "file not found");
+/// All whitespace-separated numbers of a text; a token that is not a number is an error naming
+/// `path`, the text's source.
+inline std::vector<double> parseNumbers(std::istream& in, const std::filesystem::path& path) {
   std::vector<double> values;
   std::string token;
   while (in >> token) {
@@ -28,6 +28,12 @@ inline std::vector<double> readNumbers(const std::filesystem::path& path) {
     values.push_back(value);
   }
   return values;
+}
+
+/// All whitespace-separated numbers of a text file (parseNumbers).
+inline std::vector<double> readNumbers(const std::filesystem::path& path) {
+  std::ifstream in = openForReading(path);
+  return parseNumbers(in, path);
 }
 
 }  // namespace bundletrack::io

@@ -2,11 +2,13 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cmath>
 #include <filesystem>
 #include <optional>
 #include <string>
 #include <vector>
 
+#include "bundletrack/core/angles.hpp"
 #include "bundletrack/core/rgbd_frame.hpp"
 #include "bundletrack/core/se3.hpp"
 #include "bundletrack/io/image_files.hpp"
@@ -86,6 +88,7 @@ class YcbineoatSequence {
                                                 std::to_string(camera_.cy) + ") lies outside the " +
                                                 std::to_string(image_size_.width) + "x" +
                                                 std::to_string(image_size_.height) + " image");
+    checkFieldOfView();
     const auto first_mask = mask(0);
     if (!first_mask) throw InputError(maskPath(0), "the first frame needs an object mask: file not found");
     if (cv::countNonZero(*first_mask) == 0) throw InputError(maskPath(0), "the first frame's object mask is empty");
@@ -166,6 +169,25 @@ class YcbineoatSequence {
     if (median > 20.0)
       throw InputError(path, stated + ": farther than any RGB-D sensor measures; the depth scale is probably too large"
                                       " (images in millimetres need 0.001, not 1)");
+  }
+
+  /// K must fit the images: RGB-D cameras see 40-120 degrees across (Kinect v1 57, RealSense D435
+  /// 69-87, Azure Kinect 75-120), so a field of view outside 10-170 degrees, or pixels more than
+  /// twice as tall as wide (fx / fy), is a K for another image size or in other units.
+  void checkFieldOfView() const {
+    const auto view = [](double pixels, double focal) { return degrees(2.0 * std::atan(0.5 * pixels / focal)); };
+    const double across = view(image_size_.width, camera_.fx), down = view(image_size_.height, camera_.fy);
+    const std::string stated = "fx " + std::to_string(camera_.fx) + " px, fy " + std::to_string(camera_.fy) +
+                               " px give a field of view of " + std::to_string(across) + " x " + std::to_string(down) +
+                               " degrees for the " + std::to_string(image_size_.width) + "x" +
+                               std::to_string(image_size_.height) + " images";
+    if (std::min(across, down) < 10.0 || std::max(across, down) > 170.0)
+      throw InputError(root_ / "cam_K.txt", stated + "; RGB-D cameras see 40-120 degrees: is K for another image size "
+                                                     "or in other units?");
+    const double aspect = camera_.fx / camera_.fy;
+    if (aspect < 0.5 || aspect > 2.0)
+      throw InputError(root_ / "cam_K.txt", stated + ": fx / fy = " + std::to_string(aspect) +
+                                                ", pixels far from square: is K mistyped?");
   }
 
   void requireSize(const cv::Mat& image, const std::filesystem::path& path) const {
