@@ -6,8 +6,9 @@
 // percentile of the milliseconds per frame and the share of the median frame; the whole run's
 // milliseconds per frame (files to poses) and, for sequences, the time to merely decode the same
 // files with OpenCV (colour, depth, mask; one pass before the run) and the ratio of the two.
-// --memory-every N also prints, every N frames, the keyframes in the pool and the process's
-// resident and peak resident memory (Linux /proc/self/status).
+// --memory-every N also prints, every N frames, the keyframes in the pool, the process's resident
+// and peak resident memory (Linux /proc/self/status) and the mean milliseconds per frame
+// (preprocessing and tracking) over those N frames.
 // --gpu (builds with BUNDLETRACK_CUDA) also runs the tracker composed of the GPU policies on the
 // same frames and prints both per-stage medians side by side with the GPU/CPU ratio.
 #include <algorithm>
@@ -82,8 +83,11 @@ template <typename ReadAt>
 Stages track(bt::AnyTracker& tracker, const bt::PinholeCameraf& camera, std::size_t frames, int memory_every,
              ReadAt&& read_at) {
   Stages stages;
-  if (memory_every > 0) std::printf("%8s %10s %12s %13s %6s\n", "frame", "keyframes", "resident MiB", "peak MiB", "lost");
+  if (memory_every > 0)
+    std::printf("%8s %10s %12s %13s %6s %11s\n", "frame", "keyframes", "resident MiB", "peak MiB", "lost", "ms / frame");
   int lost = 0;
+  double interval_ms = 0.0;  // preprocessing and tracking since the last memory line
+  std::size_t interval_frames = 0;
   bt::io::ReadAhead<Input> inputs(frames, read_at);
   bt::Stopwatch whole_run;
   for (std::size_t i = 0; i < frames; ++i) {
@@ -96,9 +100,14 @@ Stages track(bt::AnyTracker& tracker, const bt::PinholeCameraf& camera, std::siz
     lost += result.status == bt::TrackStatus::Lost;
     if (i == 0) whole_run.lap();
     if (i > 0) stages.add(read_ms, result.timings);
+    interval_ms += read_ms + result.timings.total;
+    ++interval_frames;
     if (memory_every > 0 && ((i + 1) % std::size_t(memory_every) == 0 || i + 1 == frames)) {
       const auto [rss, peak] = residentMemoryMiB();
-      std::printf("%8zu %10zu %12.1f %13.1f %6d\n", i + 1, tracker.keyframeCount(), rss, peak, lost);
+      std::printf("%8zu %10zu %12.1f %13.1f %6d %11.2f\n", i + 1, tracker.keyframeCount(), rss, peak, lost,
+                  interval_ms / double(interval_frames));
+      interval_ms = 0.0;
+      interval_frames = 0;
       std::fflush(stdout);
     }
   }
