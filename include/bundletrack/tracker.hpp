@@ -1,5 +1,6 @@
 #pragma once
 
+#include <algorithm>
 #include <optional>
 #include <utility>
 #include <vector>
@@ -304,8 +305,10 @@ class Tracker {
 
   /// Feature correspondences of an edge (paper IV-D): matches gated by the current poses (the gate
   /// widened for the sensor's noise), pruned by RANSAC; fewer than min_edge_correspondences count
-  /// as none.
+  /// as none, so a frame with fewer features (one tracked without keypoints) is not matched at all.
   std::vector<FeatureMatch> edgeCorrespondences(const Keyframe& a, const Keyframe& b, const SE3d& T_a, const SE3d& T_b) {
+    const auto fewest = std::size_t(std::max(0, settings_.min_edge_correspondences));
+    if (a.features.size() < fewest || b.features.size() < fewest) return {};
     const SurfaceGate gate = settings_.edge_gate.widened(NoiseScale::between(a.features.noise_scale, b.features.noise_scale));
     PairRegistration pair = registerPair(a.features, b.features, MatchGate{(T_b * T_a.inverse()).cast<float>(), gate});
     if (int(pair.inliers.size()) < settings_.min_edge_correspondences) return {};

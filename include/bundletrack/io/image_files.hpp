@@ -1,7 +1,6 @@
 #pragma once
 
 #include <algorithm>
-#include <cstring>
 #include <filesystem>
 #include <iterator>
 #include <string>
@@ -63,7 +62,6 @@ inline cv::Mat decodeImage(const std::vector<uchar>& bytes, int flags, const std
 inline cv::Mat readImage(const std::filesystem::path& path, int flags) {
   std::ifstream in = openForReading(path, std::ios::binary);
   const std::vector<uchar> bytes{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-  if (!in.eof() && in.fail()) throw InputError(path, std::string("cannot be read: ") + std::strerror(errno));
   return decodeImage(bytes, flags, path);
 }
 
