@@ -3,10 +3,12 @@
 
 #include <memory>
 #include <random>
+#include <set>
 #include <span>
 
 #include "bundletrack/energy.hpp"
 #include "bundletrack/graph/keyframe_pool.hpp"
+#include "bundletrack/graph/relocalisation.hpp"
 #include "bundletrack/residuals/dense_point_to_plane.hpp"
 #include "bundletrack/residuals/feature_point_to_point.hpp"
 #include "bundletrack/solvers/dense_ldlt.hpp"
@@ -286,4 +288,37 @@ TEST_CASE("keyframe pool: greedy selection keeps frame 0 and follows the geodesi
   CHECK(pool.add(extra) == 3);
   CHECK(pool.size() == 4);
   CHECK(pool[0].id == 0);
+}
+
+TEST_CASE("re-acquisition starts: turned about the object's centre by each ring, and the largest consensus") {
+  const bt::SE3d pose(bt::SO3d::exp(Eigen::Vector3d(0.1, -0.3, 0.2)), Eigen::Vector3d(0.1, 0.0, 2.0));
+  const Eigen::Vector3d pivot(0.12, 0.05, 2.1);
+  const double step = 20.0 * 3.141592653589793 / 180.0;
+  const std::vector<bt::SE3d> starts = bt::turnedAbout(pose, pivot, step, 2);
+  REQUIRE(starts.size() == 12);
+  for (std::size_t k = 0; k < starts.size(); ++k) {
+    const double ring = k < 6 ? 1.0 : 2.0;
+    // Turned by ring * step relative to the pose, about a camera axis, the pivot kept in place.
+    const bt::SO3d turn = starts[k].rotation() * pose.rotation().inverse();
+    CHECK(bt::rotationGeodesic(starts[k].rotation(), pose.rotation()) == doctest::Approx(ring * step).epsilon(1e-12));
+    CHECK(turn.log().normalized().cwiseAbs().maxCoeff() == doctest::Approx(1.0).epsilon(1e-12));
+    const Eigen::Vector3d pivot_in_object = pose.inverse() * pivot;
+    CHECK((starts[k] * pivot_in_object - pivot).norm() < 1e-12);
+  }
+  CHECK(bt::turnedAbout(pose, pivot, step, 0).empty());
+
+  // Three poses within 1 degree and 5 mm of the second, two far from them and from each other.
+  const auto nudged = [&](double angle_deg, double metres) {
+    return bt::SE3d(bt::SO3d::exp(Eigen::Vector3d(0, 0, angle_deg * 3.141592653589793 / 180.0)),
+                    Eigen::Vector3d(metres, 0, 0)) * pose;
+  };
+  const std::vector<bt::SE3d> reached = {nudged(90, 0.0), nudged(0.5, 0.002), nudged(-0.4, 0.0), nudged(0.9, -0.002),
+                                         nudged(45, 0.1)};
+  const double two_degrees = 2.0 * 3.141592653589793 / 180.0;
+  const std::vector<std::size_t> group = bt::largestConsensus(reached, two_degrees, 0.005);
+  REQUIRE(group.size() == 3);
+  CHECK(group[0] == 1);  // the first member whose neighbourhood holds the others
+  CHECK(std::set<std::size_t>(group.begin(), group.end()) == std::set<std::size_t>{1, 2, 3});
+  CHECK(bt::largestConsensus({}, two_degrees, 0.005).empty());
+  CHECK(bt::largestConsensus(reached, two_degrees, 0.001).size() == 1);  // 2 mm apart: none agree
 }

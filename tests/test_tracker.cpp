@@ -273,6 +273,48 @@ TEST_CASE("after the object was out of view, it is re-acquired with fewer than 1
   CHECK(run(features_only).first_recovered == -1);  // features alone never come back
 }
 
+TEST_CASE("a textureless chair 2.5 m away comes back 27 degrees turned: re-acquired on return by its surface") {
+  synth::SyntheticSequenceSettings settings;  // the stress matrix's D_chair_2.5m_textureless_out_of_view
+  settings.frames = 62;
+  settings.shape = synth::Shape::Chair;
+  settings.size = 0.70;
+  settings.distance = 2.5;
+  settings.textureless = true;
+  settings.hidden_start = 40;  // back at frame 55, turned 27 degrees past the last frame seen
+  settings.hidden_frames = 15;
+  const synth::SyntheticScene scene(settings);
+  const auto camera = settings.camera.cast<float>();
+  const auto model = scene.objectMesh().sampleSurface(1000, 1);
+  const auto run = [&](const bt::TrackerSettings& tracking) {
+    bt::DefaultTracker tracker(camera, tracking);
+    struct {
+      int lost_in_view = 0, wrong = 0;
+    } out;
+    for (int i = 0; i < settings.frames; ++i) {
+      const synth::SyntheticFrame f = scene.frame(i);
+      const bt::RgbdFrame frame = bt::makeFrame(std::to_string(i), f.color, f.depth, f.mask, camera);
+      const bt::TrackResult r = i == 0 ? tracker.initialize(frame, f.T_cam_obj) : tracker.track(frame);
+      const bool gone = i >= settings.hidden_start && i < settings.hidden_start + settings.hidden_frames;
+      if (r.status == bt::TrackStatus::Lost) {
+        out.lost_in_view += !gone;
+        continue;
+      }
+      // Tracked poses of this cell stay within 3 degrees and 1 cm (bench/ACCURACY.md); a wrong
+      // minimum (the chair turned by 90 degrees, seat and legs on the seen ones) is far off.
+      out.wrong += bt::rotationErrorDeg(f.T_cam_obj, r.T_cam_obj) > 5.0 || bt::translationError(f.T_cam_obj, r.T_cam_obj) > 0.02;
+    }
+    MESSAGE("lost in view " << out.lost_in_view << ", wrong poses " << out.wrong);
+    return out;
+  };
+  const auto turned = run(bt::TrackerSettings());
+  CHECK(turned.lost_in_view == 0);
+  CHECK(turned.wrong == 0);
+  bt::TrackerSettings untuned;  // the candidates of before: the last good pose, moved onto the object
+  untuned.recovery_turn_rings = 0;
+  untuned.recovery_min_consensus = 1000;
+  CHECK(run(untuned).lost_in_view >= 5);  // the right pose agrees with the keyframes at 0.57-0.68 only
+}
+
 /// The object leaves the view for 30 frames: reported lost while gone, recovered within 10 frames
 /// of its return, and no wrong pose is ever reported as good.
 template <typename Tracker>

@@ -224,17 +224,27 @@ class Tracker {
       }
     }
     by_surface.push_back({last_->T_cam_obj, false, false, Evidence::SurfaceOnly, {}});
-    if (const std::optional<SE3d> moved = movedOntoObject(ctx.masked))
-      by_surface.push_back({*moved, false, false, Evidence::SurfaceOnly, {}});
+    const std::optional<Placement> moved = movedOntoObject(ctx.masked);
+    if (moved) by_surface.push_back({moved->T_cam_obj, false, false, Evidence::SurfaceOnly, {}});
     by_surface.resize(std::min(by_surface.size(), std::size_t(std::max(0, settings_.recovery_surface_candidates))));
+    if (moved && !by_surface.empty())
+      for (const SE3d& turned : turnedAbout(moved->T_cam_obj, moved->centroid, radians(settings_.recovery_turn_step_deg),
+                                            settings_.recovery_turn_rings))
+        by_surface.push_back({turned, false, false, Evidence::SurfaceOnly, {}});
     for (CoarseEstimate& coarse : by_surface) ctx.candidates.push_back(std::move(coarse));
     return !ctx.candidates.empty();
   }
 
+  /// A pose placed on the points of a frame, and their centroid (camera frame).
+  struct Placement {
+    SE3d T_cam_obj;
+    Eigen::Vector3d centroid;
+  };
+
   /// A coarse geometric search: the last good pose translated by the offset between the centroid of
   /// the last good frame's object points and that of the points in this frame's search region;
   /// none when the region holds no points or is far larger than the object (it is not the object).
-  std::optional<SE3d> movedOntoObject(const RgbdFrame& masked) const {
+  std::optional<Placement> movedOntoObject(const RgbdFrame& masked) const {
     const SurfaceGrid& seen = last_->surface;
     if (seen.cells.empty()) return std::nullopt;
     Eigen::Vector3d before = Eigen::Vector3d::Zero(), now = Eigen::Vector3d::Zero();
@@ -255,23 +265,58 @@ class Tracker {
     }
     if (count == 0 || count > 2 * int(seen.cells.size())) return std::nullopt;
     now /= double(count);
-    return SE3d(SO3d(), now - before) * last_->T_cam_obj;
+    return Placement{SE3d(SO3d(), now - before) * last_->T_cam_obj, now};
   }
 
   /// Paper IV-C to IV-E's checks on each coarse pose in turn (segment under it, build and optimise
-  /// the graph, verify); the first accepted result is the frame's.
+  /// the graph, verify); the first accepted result is the frame's. After lost frames the
+  /// candidates with the surface alone behind them are all optimised and decided together
+  /// (TrackerSettings::recovery_min_consensus).
   bool refineCoarsePose(FrameContext& ctx) {
-    const FrameFeatures detected = ctx.candidates.size() > 1 ? ctx.features : FrameFeatures();
+    const bool several = ctx.recovering || ctx.candidates.size() > 1;  // tries that need the features again
+    const FrameFeatures detected = several ? ctx.features : FrameFeatures();
+    const FrameFeatures* features = several ? &detected : nullptr;
+    std::vector<SE3d> reached;  // by surface-only candidates the verifier's min_agreement admits ...
+    std::vector<std::size_t> reached_from;  // ... and from which
+    std::optional<std::size_t> first_confirmed;  // the first that passes the SurfaceOnly test
     for (std::size_t k = 0; k < ctx.candidates.size(); ++k) {
-      if (k > 0) ctx.features = detected;
-      ctx.coarse = std::move(ctx.candidates[k]);
-      if (!segmentObject(ctx)) continue;  // not where the coarse pose says
-      makeNode(ctx);
-      buildGraph(ctx);
-      optimiseGraph(ctx);
-      if (acceptPose(ctx)) return true;
+      if (!optimiseFrom(ctx, ctx.candidates[k], features)) continue;
+      if (!ctx.recovering || ctx.coarse.evidence != Evidence::SurfaceOnly) {
+        if (acceptPose(ctx)) return true;
+        continue;
+      }
+      if (verifier_.accepts(ctx.graph, Evidence::SurfaceConsensus)) {
+        reached.push_back(ctx.graph.poses.back());
+        reached_from.push_back(k);
+      }
+      if (!first_confirmed && verifier_.accepts(ctx.graph, Evidence::SurfaceOnly)) first_confirmed = k;
     }
-    return false;
+    const double distance =
+        reached.empty() ? 0.0 : ctx.frame.noise.widen(settings_.recovery_consensus_distance, float(reached[0].translation().z()));
+    const std::vector<std::size_t> consensus =
+        largestConsensus(reached, radians(settings_.recovery_consensus_angle_deg), distance);
+    CoarseEstimate chosen;
+    if (int(consensus.size()) >= std::max(1, settings_.recovery_min_consensus)) {
+      chosen = ctx.candidates[reached_from[consensus[0]]];
+      chosen.evidence = Evidence::SurfaceConsensus;
+    } else if (first_confirmed) {
+      chosen = ctx.candidates[*first_confirmed];
+    } else {
+      return false;
+    }
+    return optimiseFrom(ctx, chosen, features) && acceptPose(ctx);
+  }
+
+  /// The graph of the current frame from one coarse pose (false: the object is not where it says),
+  /// with the frame's `features` when given (else those in ctx, which move into the node).
+  bool optimiseFrom(FrameContext& ctx, const CoarseEstimate& coarse, const FrameFeatures* features) {
+    if (features) ctx.features = *features;
+    ctx.coarse = coarse;
+    if (!segmentObject(ctx)) return false;
+    makeNode(ctx);
+    buildGraph(ctx);
+    optimiseGraph(ctx);
+    return true;
   }
 
   /// The object's mask under the coarse pose; keypoints off it are dropped.

@@ -48,6 +48,22 @@ struct TrackerSettings {
   /// good pose moved onto the object's points in this frame -- and the first whose result the
   /// verifier accepts on Evidence::SurfaceOnly is kept (0: features alone).
   int recovery_surface_candidates = 4;
+  /// The object may come back turned far from where it left: the last good pose moved onto the
+  /// object's points is also tried turned about their centroid by k * recovery_turn_step_deg,
+  /// k = 1..recovery_turn_rings, both ways about each camera axis (turnedAbout; 0 rings: none).
+  double recovery_turn_step_deg = 20.0;
+  int recovery_turn_rings = 2;
+  /// Every surface candidate of a lost frame is optimised; a pose reached from at least
+  /// recovery_min_consensus of them (within recovery_consensus_angle_deg and
+  /// recovery_consensus_distance, the distance widened for the sensor's noise) needs only the
+  /// verifier's min_agreement (Evidence::SurfaceConsensus); without one the first candidate that
+  /// passes recovery_min_agreement is kept. A view turned 27 degrees past every keyframe agrees
+  /// with them at only 0.57-0.68 when right (a chair 2.5 m away), while a wrong minimum reached
+  /// from one start can pass 0.8 (that chair turned by 90 degrees); right poses were reached from
+  /// 8 of 14 starts within 0.6 degrees and 0.5 cm.
+  int recovery_min_consensus = 3;
+  double recovery_consensus_angle_deg = 2.0;
+  float recovery_consensus_distance = 0.01f;
   /// OnDemand by default: on the stress matrix (bench/ACCURACY.md) it is within 0.2 ADD-S of
   /// EveryFrame on every cell, and it skips keypoints on most frames of the shared container and
   /// mug (bench/RESULTS.md); EveryFrame is the paper's schedule.

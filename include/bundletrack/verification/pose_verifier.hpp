@@ -10,6 +10,9 @@ namespace bundletrack {
 enum class Evidence {
   Features,  ///< feature matches with RANSAC inliers gave the coarse pose
   SurfaceOnly,  ///< nothing but the surface: a texture-poor frame re-acquired from the last good pose
+  /// nothing but the surface, but the pose graph reached the pose from several starts far apart
+  /// (largestConsensus): as trustworthy as a feature registration
+  SurfaceConsensus,
 };
 
 /// Decides whether the pose graph's result for the current frame (its last node) can be trusted;
