@@ -78,6 +78,27 @@ inline cv::Mat depthFromImage(const cv::Mat& raw, double scale, const std::files
   return metres;
 }
 
+/// The commonest mistake with a new dataset is the depth unit: the object's median depth (metres,
+/// `depth` under `mask`) must lie between 5 cm and 20 m, the range of any RGB-D sensor. `scale`
+/// is the unit the depth was read with, `source` names the depth in the error.
+inline void checkDepthScale(const cv::Mat& depth, const cv::Mat& mask, double scale, const std::filesystem::path& source) {
+  std::vector<float> values;
+  for (int v = 0; v < depth.rows; ++v)
+    for (int u = 0; u < depth.cols; ++u)
+      if (mask.at<uchar>(v, u) && depth.at<float>(v, u) > 0.0f) values.push_back(depth.at<float>(v, u));
+  if (values.empty()) throw InputError(source, "no valid depth under the first frame's object mask");
+  std::nth_element(values.begin(), values.begin() + std::ptrdiff_t(values.size() / 2), values.end());
+  const double median = values[values.size() / 2];
+  const std::string stated =
+      "median object depth is " + std::to_string(median) + " m with depth scale " + std::to_string(scale) + " m/unit";
+  if (median < 0.05)
+    throw InputError(source, stated + ": closer than any RGB-D sensor measures; the depth scale is probably too small"
+                                      " (images in millimetres need 0.001, in 0.1 mm 0.0001)");
+  if (median > 20.0)
+    throw InputError(source, stated + ": farther than any RGB-D sensor measures; the depth scale is probably too large"
+                                      " (images in millimetres need 0.001, not 1)");
+}
+
 /// The depth of an image file (depthFromImage).
 inline cv::Mat readDepth(const std::filesystem::path& path, double scale) {
   return depthFromImage(readImage(path, cv::IMREAD_UNCHANGED), scale, path);

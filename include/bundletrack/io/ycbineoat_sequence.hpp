@@ -88,11 +88,11 @@ class YcbineoatSequence {
                                                 std::to_string(camera_.cy) + ") lies outside the " +
                                                 std::to_string(image_size_.width) + "x" +
                                                 std::to_string(image_size_.height) + " image");
-    checkFieldOfView();
+    checkFieldOfView(camera_, image_size_, root_ / "cam_K.txt");
     const auto first_mask = mask(0);
     if (!first_mask) throw InputError(maskPath(0), "the first frame needs an object mask: file not found");
     if (cv::countNonZero(*first_mask) == 0) throw InputError(maskPath(0), "the first frame's object mask is empty");
-    checkDepthScale(*first_mask);
+    checkDepthScale(rawDepth(0), *first_mask, settings_.depth_scale, depthPath(0));
   }
 
   std::size_t size() const { return names_.size(); }
@@ -149,47 +149,6 @@ class YcbineoatSequence {
   std::vector<Eigen::Vector3f> modelPoints() const { return readPoints(modelPath()); }
 
  private:
-  /// The commonest mistake with a new dataset is the depth unit: the object's median depth in the
-  /// first frame must lie between 5 cm and 20 m, the range of any RGB-D sensor.
-  void checkDepthScale(const cv::Mat& first_mask) const {
-    const cv::Mat depth = rawDepth(0);
-    std::vector<float> values;
-    for (int v = 0; v < depth.rows; ++v)
-      for (int u = 0; u < depth.cols; ++u)
-        if (first_mask.at<uchar>(v, u) && depth.at<float>(v, u) > 0.0f) values.push_back(depth.at<float>(v, u));
-    const auto path = depthPath(0);
-    if (values.empty()) throw InputError(path, "no valid depth under the first frame's object mask");
-    std::nth_element(values.begin(), values.begin() + std::ptrdiff_t(values.size() / 2), values.end());
-    const double median = values[values.size() / 2], scale = settings_.depth_scale;
-    const std::string stated = "median object depth is " + std::to_string(median) + " m with depth scale " +
-                               std::to_string(scale) + " m/unit";
-    if (median < 0.05)
-      throw InputError(path, stated + ": closer than any RGB-D sensor measures; the depth scale is probably too small"
-                                      " (images in millimetres need 0.001, in 0.1 mm 0.0001)");
-    if (median > 20.0)
-      throw InputError(path, stated + ": farther than any RGB-D sensor measures; the depth scale is probably too large"
-                                      " (images in millimetres need 0.001, not 1)");
-  }
-
-  /// K must fit the images: RGB-D cameras see 40-120 degrees across (Kinect v1 57, RealSense D435
-  /// 69-87, Azure Kinect 75-120), so a field of view outside 10-170 degrees, or pixels more than
-  /// twice as tall as wide (fx / fy), is a K for another image size or in other units.
-  void checkFieldOfView() const {
-    const auto view = [](double pixels, double focal) { return degrees(2.0 * std::atan(0.5 * pixels / focal)); };
-    const double across = view(image_size_.width, camera_.fx), down = view(image_size_.height, camera_.fy);
-    const std::string stated = "fx " + std::to_string(camera_.fx) + " px, fy " + std::to_string(camera_.fy) +
-                               " px give a field of view of " + std::to_string(across) + " x " + std::to_string(down) +
-                               " degrees for the " + std::to_string(image_size_.width) + "x" +
-                               std::to_string(image_size_.height) + " images";
-    if (std::min(across, down) < 10.0 || std::max(across, down) > 170.0)
-      throw InputError(root_ / "cam_K.txt", stated + "; RGB-D cameras see 40-120 degrees: is K for another image size "
-                                                     "or in other units?");
-    const double aspect = camera_.fx / camera_.fy;
-    if (aspect < 0.5 || aspect > 2.0)
-      throw InputError(root_ / "cam_K.txt", stated + ": fx / fy = " + std::to_string(aspect) +
-                                                ", pixels far from square: is K mistyped?");
-  }
-
   void requireSize(const cv::Mat& image, const std::filesystem::path& path) const {
     if (image.size() != image_size_)
       throw InputError(path, "image is " + std::to_string(image.cols) + "x" + std::to_string(image.rows) +
