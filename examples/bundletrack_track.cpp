@@ -23,6 +23,7 @@
 #include "bundletrack/eval/pose_metrics.hpp"
 #include "bundletrack/eval/score_table.hpp"
 #include "bundletrack/eval/sequence_score.hpp"
+#include "bundletrack/io/model_file.hpp"
 #include "bundletrack/io/read_ahead.hpp"
 #include "bundletrack/runtime/make_tracker.hpp"
 #include "bundletrack/tracking/stopwatch.hpp"
@@ -310,6 +311,11 @@ int run(bt::AnyTracker& tracker, const bt::io::YcbineoatSequence& sequence, cons
     for (const double iou : mask_ious) sum += iou;
     std::printf("propagated mask IoU against the sequence's masks: mean %.3f, min %.3f over %zu frames\n",
                 sum / double(mask_ious.size()), *std::min_element(mask_ious.begin(), mask_ious.end()), mask_ious.size());
+  }
+  if (const std::vector<bt::ModelPoint> object = tracker.objectModel(); !object.empty()) {
+    bt::io::writeModelPly(options.out / "model.ply", object);
+    std::printf("object model: %s (%zu points fused from %zu keyframes)\n", (options.out / "model.ply").string().c_str(),
+                object.size(), tracker.keyframeCount());
   }
   if (scored) {
     // A lost frame keeps the last good pose, which the first row scores as its estimate; where

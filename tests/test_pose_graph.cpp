@@ -8,6 +8,7 @@
 
 #include "bundletrack/energy.hpp"
 #include "bundletrack/graph/keyframe_pool.hpp"
+#include "bundletrack/graph/object_model.hpp"
 #include "bundletrack/graph/relocalisation.hpp"
 #include "bundletrack/residuals/dense_point_to_plane.hpp"
 #include "bundletrack/residuals/feature_point_to_point.hpp"
@@ -321,4 +322,45 @@ TEST_CASE("re-acquisition starts: turned about the object's centre by each ring,
   CHECK(std::set<std::size_t>(group.begin(), group.end()) == std::set<std::size_t>{1, 2, 3});
   CHECK(bt::largestConsensus({}, two_degrees, 0.005).empty());
   CHECK(bt::largestConsensus(reached, two_degrees, 0.001).size() == 1);  // 2 mm apart: none agree
+}
+
+TEST_CASE("object model: keyframes' points averaged in the object frame, points one keyframe saw alone dropped") {
+  // A 5x5 patch of the plane z = 2 mm (object frame), 1 cm apart, mid-voxel for 4 mm voxels; seen by
+  // two keyframes at different poses, red in the first and blue in the second; the first also
+  // sees a background point.
+  const bt::SE3d poses[2] = {bt::SE3d(bt::SO3d(), Eigen::Vector3d(0, 0, 1.0)),
+                             bt::SE3d(bt::SO3d::exp(Eigen::Vector3d(0.35, 0, 0)), Eigen::Vector3d(0.01, 0, 1.1))};
+  const cv::Vec3b colors[2] = {{0, 0, 200}, {100, 0, 0}};
+  bt::KeyframePool pool(4);
+  for (int k = 0; k < 2; ++k) {
+    bt::Keyframe keyframe;
+    keyframe.id = k;
+    keyframe.T_cam_obj = poses[k];
+    bt::SurfaceGrid& grid = keyframe.surface;
+    grid.camera = {100.0f, 100.0f, 5.0f, 5.0f};
+    grid.points = cv::Mat::zeros(6, 6, CV_32FC3);
+    grid.normals = cv::Mat::zeros(6, 6, CV_32FC3);
+    for (int i = 0; i < 5; ++i)
+      for (int j = 0; j < 5; ++j) {
+        const Eigen::Vector3f p = (poses[k] * Eigen::Vector3d(0.01 * i + 0.001, 0.01 * j + 0.001, 0.002)).cast<float>();
+        const Eigen::Vector3f n = (poses[k].rotation() * Eigen::Vector3d(0, 0, -1)).cast<float>();
+        grid.points.at<cv::Vec3f>(j, i) = {p.x(), p.y(), p.z()};
+        grid.normals.at<cv::Vec3f>(j, i) = {n.x(), n.y(), n.z()};
+      }
+    if (k == 0) {
+      grid.points.at<cv::Vec3f>(5, 5) = {0.3f, 0.3f, 1.5f};
+      grid.normals.at<cv::Vec3f>(5, 5) = {0.0f, 0.0f, -1.0f};
+    }
+    bt::indexCells(grid);
+    grid.colors.assign(grid.cells.size(), colors[k]);
+    pool.add(keyframe);
+  }
+  const std::vector<bt::ModelPoint> model = bt::fuseObjectModel(pool, {0.004f, 2});
+  REQUIRE(model.size() == 25);
+  for (const bt::ModelPoint& p : model) {
+    CHECK(p.position.z() == doctest::Approx(0.002).epsilon(1e-5));
+    CHECK((p.normal - Eigen::Vector3f(0, 0, -1)).norm() < 1e-5);
+    CHECK(p.color == cv::Vec3b(50, 0, 100));  // the mean of both keyframes' colours
+  }
+  CHECK(bt::fuseObjectModel(pool, {0.004f, 1}).size() == 26);  // with the background point
 }

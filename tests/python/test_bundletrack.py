@@ -41,9 +41,9 @@ def files(seq, i):
             cv2.imread(str(seq / "masks" / name), cv2.IMREAD_UNCHANGED))
 
 
-def track_files(seq, config=None, masks=True):
+def track_files(seq, config=None, masks=True, tracker=None):
     sequence = bt.Sequence(str(seq))
-    tracker = bt.Tracker(config)
+    tracker = tracker or bt.Tracker(config)
     poses = []
     for i in range(len(sequence)):
         rgb, depth, mask = files(seq, i)
@@ -55,6 +55,12 @@ def track_files(seq, config=None, masks=True):
     return poses
 
 
+def read_ply(path):
+    lines = path.read_text().splitlines()
+    body = lines[lines.index("end_header") + 1:]
+    return np.array([list(map(float, line.split())) for line in body])
+
+
 def largest_difference(a, b):
     assert len(a) == len(b) == FRAMES
     return max(np.abs(x - y).max() for x, y in zip(a, b))
@@ -63,6 +69,25 @@ def largest_difference(a, b):
 def test_numpy_frames_give_the_cli_poses(box):
     # The CLI writes 10 decimals; the same computation differs by at most their rounding.
     assert largest_difference(track_files(box / "seq"), cli_poses(box, "given")) <= 1e-9
+
+
+def test_object_model_equals_the_cli_model_and_lies_on_the_box(box, tmp_path):
+    tracker = bt.Tracker()
+    track_files(box / "seq", tracker=tracker)
+    model = tracker.object_model()
+    points, normals, colors = model["points"], model["normals"], model["colors"]
+    assert points.shape == normals.shape == colors.shape and points.dtype == np.float32 and colors.dtype == np.uint8
+    cli = read_ply(box / "given" / "model.ply")  # x y z nx ny nz red green blue
+    assert cli.shape == (len(points), 9)
+    assert np.abs(cli[:, :3] - points).max() < 1e-6  # PLY's printed digits
+    assert np.array_equal(cli[:, 6:9], colors[:, ::-1])
+    assert np.allclose(np.linalg.norm(normals, axis=1), 1.0, atol=1e-5)
+    tracker.write_model(tmp_path / "model.ply")
+    assert (tmp_path / "model.ply").read_text() == (box / "given" / "model.ply").read_text()
+    # Against the true surface's samples: within a few sensor spreads (1.4 mm at 0.73 m).
+    truth = bt.Sequence(str(box / "seq")).model_points()
+    nearest = np.sqrt(((points[:, None, :] - truth[None, :, :]) ** 2).sum(axis=2).min(axis=1))
+    assert np.median(nearest) < 0.01  # the samples are ~7 mm apart: this bounds sampling, not noise
 
 
 def test_propagated_masks_give_the_cli_poses(box):

@@ -6,6 +6,7 @@
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
+#include <pybind11/stl/filesystem.h>
 
 #include <cmath>
 #include <limits>
@@ -19,6 +20,7 @@
 #include "bundletrack/config/config_file.hpp"
 #include "bundletrack/eval/pose_metrics.hpp"
 #include "bundletrack/eval/sequence_score.hpp"
+#include "bundletrack/io/model_file.hpp"
 #include "bundletrack/io/ycbineoat_sequence.hpp"
 #include "bundletrack/runtime/make_tracker.hpp"
 
@@ -258,6 +260,31 @@ class PyTracker {
     return resultOf(result);
   }
 
+  /// The object's model fused from the keyframes: points and normals (Nx3 float32, object
+  /// frame, metres) and colours (Nx3 uint8 BGR).
+  py::dict objectModel() const {
+    const std::vector<bt::ModelPoint> model = tracker_ ? tracker_->objectModel() : std::vector<bt::ModelPoint>();
+    py::array_t<float> points({py::ssize_t(model.size()), py::ssize_t(3)}), normals({py::ssize_t(model.size()), py::ssize_t(3)});
+    py::array_t<std::uint8_t> colors({py::ssize_t(model.size()), py::ssize_t(3)});
+    auto p = points.mutable_unchecked<2>();
+    auto n = normals.mutable_unchecked<2>();
+    auto c = colors.mutable_unchecked<2>();
+    for (py::ssize_t k = 0; k < py::ssize_t(model.size()); ++k)
+      for (py::ssize_t d = 0; d < 3; ++d) {
+        p(k, d) = model[std::size_t(k)].position[d];
+        n(k, d) = model[std::size_t(k)].normal[d];
+        c(k, d) = model[std::size_t(k)].color[int(d)];
+      }
+    py::dict out;
+    out["points"] = points, out["normals"] = normals, out["colors"] = colors;
+    return out;
+  }
+
+  void writeModel(const std::filesystem::path& path) const {
+    if (!tracker_) throw std::runtime_error("write_model() called before initialize()");
+    bt::io::writeModelPly(path, tracker_->objectModel());
+  }
+
   int frames() const { return frames_; }
   std::size_t keyframes() const { return tracker_ ? tracker_->keyframeCount() : 0; }
   std::string configYaml() const { return bt::printConfig(config_); }
@@ -273,7 +300,7 @@ class PyTracker {
 /// A YCBInEOAT-layout sequence (README: rgb/, depth/, masks/, cam_K.txt, annotated_poses/, model/).
 class PySequence {
  public:
-  PySequence(const std::string& path, const py::object& config)
+  PySequence(const std::filesystem::path& path, const py::object& config)
       : sequence_(path, configArgument(config).sequence) {}
 
   std::size_t size() const { return sequence_.size(); }
@@ -385,12 +412,16 @@ PYBIND11_MODULE(bundletrack, m) {
            "float32 metres, mask HxW bool / uint8, K 3x3 intrinsics, pose 4x4 T_cam_obj (None: identity)")
       .def("track", &PyTracker::track, py::arg("rgb"), py::arg("depth"), py::arg("mask") = py::none(),
            "Tracks the next frame (its mask with masks.source 'given', the default; none with 'propagated')")
+      .def("object_model", &PyTracker::objectModel,
+           "the object's model fused from the keyframes: {'points', 'normals'} Nx3 float32 (object frame, metres), "
+           "{'colors'} Nx3 uint8 BGR")
+      .def("write_model", &PyTracker::writeModel, py::arg("path"), "writes the object model as a PLY point cloud")
       .def_property_readonly("frames", &PyTracker::frames, "frames seen so far")
       .def_property_readonly("keyframes", &PyTracker::keyframes, "keyframes in memory")
       .def_property_readonly("config_yaml", &PyTracker::configYaml, "the effective configuration as YAML");
 
   py::class_<PySequence>(m, "Sequence", "Sequence(path, config=None): a YCBInEOAT-layout sequence (README)")
-      .def(py::init<const std::string&, const py::object&>(), py::arg("path"), py::arg("config") = py::none())
+      .def(py::init<const std::filesystem::path&, const py::object&>(), py::arg("path"), py::arg("config") = py::none())
       .def("__len__", &PySequence::size)
       .def_property_readonly("names", &PySequence::names)
       .def_property_readonly("K", &PySequence::intrinsics, "3x3 intrinsics (cam_K.txt)")

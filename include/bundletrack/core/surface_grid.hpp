@@ -26,10 +26,10 @@ struct SurfaceGrid {
   cv::Mat points;  ///< CV_32FC3
   cv::Mat normals;  ///< CV_32FC3
   std::vector<cv::Point> cells;  ///< grid cells with a point, row by row
+  std::vector<cv::Vec3b> colors;  ///< BGR of each cell, in the order of `cells` (empty: no colour image)
   PinholeCameraf camera{};
   double noise_scale = 1.0;  ///< the sensor's NoiseScale at the points' median depth
   int step = 1;  ///< full-resolution pixels between neighbouring cells
-
 
   bool inside(int u, int v) const { return u >= 0 && v >= 0 && u < points.cols && v < points.rows; }
 };
@@ -60,7 +60,9 @@ inline SurfaceGrid sampleSurface(const RgbdFrame& frame, const cv::Mat& mask, co
       const bool use = mask.at<uchar>(v, u) && frame.points.at<cv::Vec3f>(v, u)[2] > 0.0f && n[2] != 0.0f;
       grid.points.at<cv::Vec3f>(y, x) = use ? frame.points.at<cv::Vec3f>(v, u) : cv::Vec3f(0, 0, 0);
       grid.normals.at<cv::Vec3f>(y, x) = use ? n : cv::Vec3f(0, 0, 0);
-      if (use) grid.cells.emplace_back(x, y);
+      if (!use) continue;
+      grid.cells.emplace_back(x, y);
+      if (!frame.color.empty()) grid.colors.push_back(frame.color.at<cv::Vec3b>(v, u));
     }
   }
   std::vector<float> depths;

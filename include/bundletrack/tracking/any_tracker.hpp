@@ -5,6 +5,7 @@
 #include <utility>
 
 #include "bundletrack/core/rgbd_frame.hpp"
+#include "bundletrack/graph/object_model.hpp"
 #include "bundletrack/tracking/track_result.hpp"
 
 namespace bundletrack {
@@ -22,6 +23,8 @@ class AnyTracker {
   virtual cv::Rect regionOfInterest(cv::Size image, const cv::Mat& given_mask) const = 0;
   /// Keyframes in memory (0 for a tracker without a pool).
   virtual std::size_t keyframeCount() const = 0;
+  /// The object's model fused from the keyframes (fuseObjectModel); empty without a pool.
+  virtual std::vector<ModelPoint> objectModel() const = 0;
 };
 
 namespace detail {
@@ -43,6 +46,10 @@ class ErasedTracker final : public AnyTracker {
   std::size_t keyframeCount() const override {
     if constexpr (requires { tracker_.keyframes().size(); }) return tracker_.keyframes().size();
     else return 0;
+  }
+  std::vector<ModelPoint> objectModel() const override {
+    if constexpr (requires { fuseObjectModel(tracker_.keyframes()); }) return fuseObjectModel(tracker_.keyframes());
+    else return {};
   }
 
  private:
