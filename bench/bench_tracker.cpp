@@ -20,7 +20,7 @@
 #include <vector>
 
 #include "bundletrack/io/read_ahead.hpp"
-#include "bundletrack/io/ycbineoat_sequence.hpp"
+#include "bundletrack/io/rgbd_sequence.hpp"
 #include "bundletrack/runtime/make_tracker.hpp"
 #include "bundletrack/synth/synthetic_sequence.hpp"
 #include "bundletrack/tracking/stopwatch.hpp"
@@ -116,7 +116,7 @@ Stages track(bt::AnyTracker& tracker, const bt::PinholeCameraf& camera, std::siz
 }
 
 /// Milliseconds per frame to decode a sequence's files with OpenCV alone (colour, depth, mask).
-double decodeOnlyMs(const bt::io::YcbineoatSequence& sequence, std::size_t frames) {
+double decodeOnlyMs(const bt::io::RgbdSequence& sequence, std::size_t frames) {
   bt::Stopwatch clock;
   for (std::size_t i = 0; i < frames; ++i) {
     const std::pair<std::filesystem::path, int> files[] = {{sequence.colorPath(i), cv::IMREAD_COLOR},
@@ -215,7 +215,7 @@ int main(int argc, char** argv) {
           });
     }
     for (const auto& dir : options.sequences) {
-      const bt::io::YcbineoatSequence sequence(dir);
+      const bt::io::RgbdSequence sequence(dir);
       const double decode_ms = decodeOnlyMs(sequence, sequence.size());
       run(
           dir, sequence.camera().cast<float>(), sequence.size(), options,

@@ -10,7 +10,7 @@
 #include "bundletrack/eval/score_table.hpp"
 #include "bundletrack/io/point_files.hpp"
 #include "bundletrack/io/pose_files.hpp"
-#include "bundletrack/io/ycbineoat_sequence.hpp"
+#include "bundletrack/io/rgbd_sequence.hpp"
 
 namespace bt = bundletrack;
 namespace fs = std::filesystem;
@@ -20,12 +20,13 @@ namespace {
 const char* const kUsage =
     "usage: bundletrack_eval --sequence DIR --poses DIR [--sequence DIR --poses DIR ...] [--json FILE]\n";
 
-/// Scoring needs only the frames' names (rgb/), the ground truth and the model: a sequence without
+/// Scoring needs only the frames' names (rgb/ or rgb.txt), the ground truth and the model: a sequence without
 /// depth/ or with an empty first mask is scored all the same. A frame without an annotated pose is
 /// not scored (counted in `unscored`).
 bt::NamedScore evaluate(const fs::path& sequence_dir, const fs::path& poses_dir, int& unscored) {
   if (!fs::is_directory(sequence_dir)) throw bt::InputError(sequence_dir, "sequence directory not found");
-  const std::vector<std::string> names = bt::io::listColorImages(sequence_dir).names;
+  const std::vector<std::string> names =
+      bt::io::frameFiles(sequence_dir, bt::io::Layout::Auto, bt::io::SequenceSettings().max_time_difference).names;
   if (!fs::is_directory(sequence_dir / "annotated_poses"))
     throw bt::InputError(sequence_dir / "annotated_poses", "directory not found");
   const std::vector<Eigen::Vector3f> model = bt::io::readPoints(sequence_dir / "model" / "points.xyz");

@@ -9,7 +9,7 @@
 #include <iostream>
 #include <string>
 
-#include "bundletrack/io/ycbineoat_sequence.hpp"
+#include "bundletrack/io/rgbd_sequence.hpp"
 #include "bundletrack/viz/overlay.hpp"
 
 namespace bt = bundletrack;
@@ -22,7 +22,7 @@ double median(std::vector<double> v) {
   return v[v.size() / 2];
 }
 
-void writeOverlay(const std::filesystem::path& dir, const bt::io::YcbineoatSequence& sequence,
+void writeOverlay(const std::filesystem::path& dir, const bt::io::RgbdSequence& sequence,
                   const bt::RgbdFrame& frame, std::size_t i) {
   std::filesystem::create_directories(dir);
   cv::Mat image = frame.color.clone();
@@ -60,7 +60,7 @@ int main(int argc, char** argv) {
   if (sequence_dir.empty()) return usage(argv[0]);
 
   try {
-    const bt::io::YcbineoatSequence sequence(sequence_dir, settings);
+    const bt::io::RgbdSequence sequence(sequence_dir, settings);
     const auto& K = sequence.camera();
     std::printf("sequence   %s\nframes     %zu (%s .. %s), %dx%d\nintrinsics fx %.2f fy %.2f cx %.2f cy %.2f\n",
                 sequence_dir.c_str(), sequence.size(), sequence.frameNames().front().c_str(),

@@ -1,5 +1,5 @@
 // bundletrack_synth --out DIR [options]
-// Renders a synthetic RGB-D sequence with exact ground truth in the YCBInEOAT layout.
+// Renders a synthetic RGB-D sequence with exact ground truth in the YCBInEOAT or TUM RGB-D layout.
 #include <chrono>
 #include <cstdio>
 #include <iostream>
@@ -30,6 +30,8 @@ const char* const kUsage = R"(usage: bundletrack_synth --out DIR [options]
                      bundletrack::DepthNoise)
   --no-noise         perfect sensor: no depth noise, quantisation, dropouts or colour noise
   --seed N           random seed of textures and sensor noise (1)
+  --layout L         ycbineoat (rgb/%06d.png, depth in mm) | tum (rgb.txt, depth.txt: 30 Hz timestamps,
+                     depth 4 ms after colour, in 1/5000 m) (ycbineoat)
 )";
 
 [[noreturn]] void fail(const std::string& message) {
@@ -51,6 +53,7 @@ double number(const std::string& option, const char* text) {
 
 int main(int argc, char** argv) {
   bt::synth::SyntheticSequenceSettings settings;
+  bt::io::Layout layout = bt::io::Layout::YcbInEoat;
   std::string out;
   for (int i = 1; i < argc; ++i) {
     const std::string arg = argv[i];
@@ -103,6 +106,11 @@ int main(int argc, char** argv) {
       settings.sensor = bt::synth::SensorSettings::perfect();
     } else if (arg == "--seed") {
       settings.seed = unsigned(number(arg, value()));
+    } else if (arg == "--layout") {
+      const std::string name = value();
+      if (name == "ycbineoat") layout = bt::io::Layout::YcbInEoat;
+      else if (name == "tum") layout = bt::io::Layout::Tum;
+      else fail("unknown layout '" + name + "' (ycbineoat | tum)");
     } else if (arg == "--help" || arg == "-h") {
       std::cout << kUsage;
       return 0;
@@ -113,7 +121,7 @@ int main(int argc, char** argv) {
   if (out.empty()) fail("--out is required");
   try {
     const auto start = std::chrono::steady_clock::now();
-    bt::synth::writeSyntheticSequence(out, settings);
+    bt::synth::writeSyntheticSequence(out, settings, layout);
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     std::printf("wrote %d frames to %s in %.1f s\n", settings.frames, out.c_str(), seconds);
   } catch (const std::exception& error) {

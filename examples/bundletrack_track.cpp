@@ -40,7 +40,7 @@ const char* const kUsage = R"(usage: bundletrack_track --sequence DIR --out DIR 
   --print-config-table  print every setting with its default as a Markdown table and exit
   --features F       sift | orb | akaze (sift)
   --tracker T        full: pose graph over keyframes (paper IV) | coarse: frame-to-frame RANSAC only (full)
-  --depth-scale S    metres per unit of the depth images (0.001)
+  --depth-scale S    metres per unit of the depth images (the layout's: 0.001 YCBInEOAT, 1/5000 TUM)
   --min-inliers N    fewest RANSAC inliers that count as a pose; fewer: the frame is lost (5)
   --inlier-mm D      RANSAC inlier distance in millimetres (5; widened by the sensor's noise)
   --sensor S         structured_light (Kinect v1, Xtion) | active_stereo (RealSense D4xx) |
@@ -99,7 +99,7 @@ struct Options {
 /// The overlays of --viz: a video when an encoder is available, and a strip of six frames.
 class OverlayWriter {
  public:
-  OverlayWriter(const fs::path& out, const bt::io::YcbineoatSequence& sequence)
+  OverlayWriter(const fs::path& out, const bt::io::RgbdSequence& sequence)
       : out_(out), camera_(sequence.camera()), frames_(sequence.size()) {
     if (sequence.hasModel()) box_ = bt::ObjectBox::bounding(sequence.modelPoints());
     video_.open((out / "overlay.mp4").string(), cv::VideoWriter::fourcc('m', 'p', '4', 'v'), 10.0, sequence.imageSize());
@@ -176,7 +176,7 @@ void prepareOutput(const fs::path& out, bool masks) {
   fs::remove(probe, error);
 }
 
-int run(bt::AnyTracker& tracker, const bt::io::YcbineoatSequence& sequence, const Options& options) {
+int run(bt::AnyTracker& tracker, const bt::io::RgbdSequence& sequence, const Options& options) {
   std::ofstream csv(options.out / "track.csv");
   const bool scored = sequence.hasGroundTruth() && sequence.hasModel();
   // Read before the work: a model that cannot be read (empty, not numbers) stops the run now, not
@@ -393,7 +393,7 @@ int main(int argc, char** argv) {
     }
     if (options.sequence.empty() || options.out.empty()) fail("--sequence and --out are required");
     prepareOutput(options.out, config.masks == "propagated");
-    const bt::io::YcbineoatSequence sequence(options.sequence, config.sequence);
+    const bt::io::RgbdSequence sequence(options.sequence, config.sequence);
     const std::unique_ptr<bt::AnyTracker> tracker = bt::makeTracker(config, sequence.camera().cast<float>());
     return run(*tracker, sequence, options);
   } catch (const std::invalid_argument& error) {

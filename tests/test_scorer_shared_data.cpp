@@ -7,7 +7,7 @@
 #include <random>
 
 #include "bundletrack/eval/sequence_score.hpp"
-#include "bundletrack/io/ycbineoat_sequence.hpp"
+#include "bundletrack/io/rgbd_sequence.hpp"
 #include "shared_data.hpp"
 
 namespace bt = bundletrack;
@@ -41,7 +41,7 @@ TEST_CASE("scorer agrees with brute force ADD-S and a literal VOCap on a shared 
     MESSAGE("SKIPPED: " << dir << " is absent");
     return;
   }
-  const bt::io::YcbineoatSequence sequence(dir);
+  const bt::io::RgbdSequence sequence(dir);
   std::vector<Eigen::Vector3f> model = sequence.modelPoints();
   model.resize(std::min<std::size_t>(model.size(), 1500));  // keeps the brute force to seconds
   std::mt19937 rng(7);

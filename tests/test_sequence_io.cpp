@@ -4,7 +4,7 @@
 
 #include <fstream>
 
-#include "bundletrack/io/ycbineoat_sequence.hpp"
+#include "bundletrack/io/rgbd_sequence.hpp"
 #include "shared_data.hpp"
 #include "temp_dir.hpp"
 
@@ -54,7 +54,7 @@ void checkInputError(F&& load, const fs::path& file, const std::string& problem)
 TEST_CASE("a valid sequence reads in numeric name order with metric depth, masks, poses and model") {
   TempDir dir("seq");
   writeValidSequence(dir.path());
-  const bt::io::YcbineoatSequence sequence(dir.path());
+  const bt::io::RgbdSequence sequence(dir.path());
   REQUIRE(sequence.size() == 3);
   CHECK(sequence.frameNames() == std::vector<std::string>{"1", "2", "10"});
   CHECK(sequence.camera().fx == 100.0);
@@ -81,10 +81,10 @@ TEST_CASE("bad input raises InputError naming the file and the problem") {
   TempDir dir("bad");
   const fs::path root = dir.path();
   writeValidSequence(root);
-  const auto open = [&] { return bt::io::YcbineoatSequence(root); };
+  const auto open = [&] { return bt::io::RgbdSequence(root); };
 
   SUBCASE("missing sequence directory") {
-    checkInputError([&] { bt::io::YcbineoatSequence(root / "nope"); }, root / "nope", "not found");
+    checkInputError([&] { bt::io::RgbdSequence(root / "nope"); }, root / "nope", "not found");
   }
   SUBCASE("missing rgb directory") {
     fs::remove_all(root / "rgb");
@@ -188,7 +188,7 @@ TEST_CASE("shared real sequences: conventions agree with the ground truth and th
   }
   for (const std::string name : {"mug_1", "magazines_1", "container_1"}) {
     CAPTURE(name);
-    const bt::io::YcbineoatSequence sequence(data / name);
+    const bt::io::RgbdSequence sequence(data / name);
     CHECK(sequence.size() > 100);
     REQUIRE(sequence.hasGroundTruth());
     const auto model = sequence.modelPoints();

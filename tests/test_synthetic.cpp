@@ -1,11 +1,15 @@
 // The synthetic renderer and sequence generator against analytic geometry.
 #include <doctest/doctest.h>
 
+#include <filesystem>
+#include <fstream>
 #include <numeric>
 
-#include "bundletrack/io/ycbineoat_sequence.hpp"
+#include "bundletrack/io/rgbd_sequence.hpp"
 #include "bundletrack/synth/synthetic_sequence.hpp"
 #include "temp_dir.hpp"
+
+namespace fs = std::filesystem;
 
 namespace bt = bundletrack;
 namespace synth = bundletrack::synth;
@@ -307,7 +311,7 @@ TEST_CASE("a written synthetic sequence reads back with its ground truth, determ
   settings.model_points = 500;
   synth::writeSyntheticSequence(dir.path() / "a", settings);
   synth::writeSyntheticSequence(dir.path() / "b", settings);
-  const bt::io::YcbineoatSequence a(dir.path() / "a"), b(dir.path() / "b");
+  const bt::io::RgbdSequence a(dir.path() / "a"), b(dir.path() / "b");
   REQUIRE(a.size() == 4);
   CHECK(a.camera().fx == kCamera.fx);
   CHECK(a.modelPoints().size() == 500);
@@ -319,5 +323,61 @@ TEST_CASE("a written synthetic sequence reads back with its ground truth, determ
   }
   settings.seed = 2;
   synth::writeSyntheticSequence(dir.path() / "c", settings);
-  CHECK(cv::norm(a.rawDepth(1), bt::io::YcbineoatSequence(dir.path() / "c").rawDepth(1), cv::NORM_INF) > 0.0);
+  CHECK(cv::norm(a.rawDepth(1), bt::io::RgbdSequence(dir.path() / "c").rawDepth(1), cv::NORM_INF) > 0.0);
+}
+
+TEST_CASE("the TUM RGB-D layout: timestamps associated, depth in 1/5000 m, the same frames as YCBInEOAT") {
+  TempDir dir("tum");
+  synth::SyntheticSequenceSettings settings;
+  settings.frames = 5;
+  settings.model_points = 200;
+  synth::writeSyntheticSequence(dir.path() / "ycb", settings);
+  synth::writeSyntheticSequence(dir.path() / "tum", settings, bt::io::Layout::Tum);
+  const bt::io::RgbdSequence ycb(dir.path() / "ycb"), tum(dir.path() / "tum");
+  REQUIRE(tum.size() == 5);
+  CHECK(tum.frameNames()[1] == "1305031102.033333");  // the colour image's timestamp
+  CHECK(tum.depthScale() == doctest::Approx(0.0002));
+  CHECK(tum.depthPath(1).filename() == "1305031102.037333.png");  // depth 4 ms later
+  const synth::SyntheticScene scene(settings);
+  for (std::size_t i = 0; i < tum.size(); ++i) {
+    CHECK((tum.groundTruthPose(i).matrix() - scene.T_cam_obj(double(i)).matrix()).norm() < 1e-8);
+    const bt::RawFrame a = ycb.read(i), b = tum.read(i);
+    CHECK(cv::norm(a.color, b.color, cv::NORM_INF) == 0.0);
+    CHECK(cv::norm(a.mask, b.mask, cv::NORM_INF) == 0.0);
+    // Both are the renderer's depth rounded: to 1 mm and to 0.2 mm.
+    const cv::Mat exact = scene.frame(int(i)).depth;
+    CHECK(cv::norm(b.depth, exact, cv::NORM_INF) <= 0.0001 + 1e-6);
+    CHECK(cv::norm(a.depth, b.depth, cv::NORM_INF) <= 0.0006 + 1e-6);
+  }
+  // Forced to YCBInEOAT, the folder's depth images are looked for by the colour images' names.
+  bt::io::SequenceSettings by_name;
+  by_name.layout = bt::io::Layout::YcbInEoat;
+  CHECK_THROWS_WITH_AS(bt::io::RgbdSequence(dir.path() / "tum", by_name),
+                       doctest::Contains("depth/1305031102.000000.png: file not found"), bt::InputError);
+}
+
+TEST_CASE("TUM lists: comments skipped, nearest depth within the window, each depth image used once") {
+  TempDir dir("tumlists");
+  const fs::path root = dir.path();
+  {
+    std::ofstream(root / "rgb.txt") << "# colour\n1.00 rgb/a.png\n\n1.10 rgb/b.png  # trailing comment\n"
+                                    << "1.50 rgb/c.png\n1.125 rgb/b2.png\n";
+    std::ofstream(root / "depth.txt") << "# depth\n1.005 depth/x.png\n1.11 depth/y.png\n2.0 depth/z.png\n";
+  }
+  const bt::io::FrameFiles frames = bt::io::tumFrames(root, 0.02);
+  // Sorted by time: a (1.00), b (1.10), b2 (1.125), c (1.50).
+  REQUIRE(frames.names == std::vector<std::string>{"a", "b", "b2", "c"});
+  CHECK(frames.depth[0] == root / "depth/x.png");
+  // y (1.11) is within 20 ms of b (10 ms) and b2 (15 ms): the nearest pair takes it, b2 has none.
+  CHECK(frames.depth[1] == root / "depth/y.png");
+  CHECK(frames.depth[2].empty());
+  CHECK(frames.depth[3].empty());  // nothing within 20 ms of 1.50
+  CHECK(frames.missing_depth[3].find("within 20 ms") != std::string::npos);
+  CHECK(frames.depth_unit == doctest::Approx(0.0002));
+  std::ofstream(root / "depth.txt") << "1.0 depth/x.png\nnot-a-time depth/y.png\n";
+  CHECK_THROWS_WITH_AS(bt::io::tumFrames(root, 0.02), doctest::Contains("line 2: 'not-a-time' is not a timestamp"),
+                       bt::InputError);
+  std::ofstream(root / "depth.txt") << "1.0\n";
+  CHECK_THROWS_WITH_AS(bt::io::tumFrames(root, 0.02), doctest::Contains("line 1: a timestamp without a file"),
+                       bt::InputError);
 }

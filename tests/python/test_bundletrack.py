@@ -26,6 +26,8 @@ def box(tmp_path_factory):
     run("bundletrack_synth", "--out", root / "seq", "--frames", FRAMES)
     run("bundletrack_track", "--sequence", root / "seq", "--out", root / "given", "--quiet")
     run("bundletrack_track", "--sequence", root / "seq", "--out", root / "propagated", "--quiet", "--propagate-masks")
+    run("bundletrack_synth", "--out", root / "tum", "--frames", FRAMES, "--layout", "tum")
+    run("bundletrack_track", "--sequence", root / "tum", "--out", root / "tum_track", "--quiet")
     return root
 
 
@@ -108,6 +110,22 @@ def test_sequence_reader_float_metres_give_the_same_poses(box):
         poses.append(result.pose)
     assert largest_difference(poses, cli_poses(box, "given")) <= 1e-9
     assert tracker.frames == FRAMES and tracker.keyframes >= 1
+
+
+def test_tum_layout_through_numpy_gives_the_cli_poses_and_the_truth(box):
+    sequence = bt.Sequence(box / "tum")  # rgb.txt, depth.txt: found by itself
+    assert sequence.names[1] == "1305031102.033333"
+    tracker = bt.Tracker()
+    poses = []
+    for i in range(len(sequence)):
+        rgb, depth, mask = sequence.read(i)
+        result = (tracker.initialize(rgb, depth, mask, sequence.K, sequence.ground_truth(0)) if i == 0
+                  else tracker.track(rgb, depth, mask))
+        poses.append(result.pose)
+    cli = [np.loadtxt(box / "tum_track" / "poses" / f"{name}.txt") for name in sequence.names]
+    assert largest_difference(poses, cli) <= 1e-9
+    score = bt.score(sequence.model_points(), [sequence.ground_truth(i) for i in range(FRAMES)], poses)
+    assert score["adds_auc"] > 95.0  # mean error under 5 mm: the depth read in the right unit
 
 
 def test_result_fields(box):

@@ -21,7 +21,7 @@
 #include "bundletrack/eval/pose_metrics.hpp"
 #include "bundletrack/eval/sequence_score.hpp"
 #include "bundletrack/io/model_file.hpp"
-#include "bundletrack/io/ycbineoat_sequence.hpp"
+#include "bundletrack/io/rgbd_sequence.hpp"
 #include "bundletrack/runtime/make_tracker.hpp"
 
 namespace py = pybind11;
@@ -212,11 +212,11 @@ class PyTracker {
     const bt::PinholeCamerad camera = bt::io::intrinsicsFromNumbers(matrixArgument(K, 3, 3, "K"), "K");
     bt::io::checkFieldOfView(camera, size, "K");
     py::array depth_owner;
-    const cv::Mat metres = depthArgument(depth, config_.sequence.depth_scale, size, depth_owner);
+    const cv::Mat metres = depthArgument(depth, arrayDepthScale(), size, depth_owner);
     if (mask.is_none()) throw bt::InputError("mask", "the first frame needs the object's mask");
     const cv::Mat object = maskArgument(mask, size);
     if (cv::countNonZero(object) == 0) throw bt::InputError("mask", "the first frame's object mask is empty");
-    bt::io::checkDepthScale(metres, object, config_.sequence.depth_scale, "depth");
+    bt::io::checkDepthScale(metres, object, arrayDepthScale(), "depth");
     const bt::SE3d T_cam_obj = pose.is_none() ? bt::SE3d() : poseArgument(pose, "pose");
     std::unique_ptr<bt::AnyTracker> tracker = bt::makeTracker(config_, camera.cast<float>());
     bt::TrackResult result;
@@ -240,7 +240,7 @@ class PyTracker {
                                       " but the first frame's is " + std::to_string(size_.width) + "x" +
                                       std::to_string(size_.height));
     py::array depth_owner;
-    const cv::Mat metres = depthArgument(depth, config_.sequence.depth_scale, size_, depth_owner);
+    const cv::Mat metres = depthArgument(depth, arrayDepthScale(), size_, depth_owner);
     const bool propagated = config_.masks == "propagated";
     if (propagated && !mask.is_none())
       throw bt::InputError("mask", "masks.source is 'propagated': the tracker follows the first mask, pass none");
@@ -290,6 +290,9 @@ class PyTracker {
   std::string configYaml() const { return bt::printConfig(config_); }
 
  private:
+  /// Metres per unit of uint16 depth arrays: depth.scale, or millimetres when it is 0 (the layout's).
+  double arrayDepthScale() const { return config_.sequence.depth_scale > 0.0 ? config_.sequence.depth_scale : 0.001; }
+
   bt::Config config_;
   std::unique_ptr<bt::AnyTracker> tracker_;
   bt::PinholeCamerad camera_{};
@@ -336,7 +339,7 @@ class PySequence {
     return i;
   }
 
-  bt::io::YcbineoatSequence sequence_;
+  bt::io::RgbdSequence sequence_;
 };
 
 std::vector<Eigen::Vector3f> pointsArgument(const py::handle& value) {

@@ -10,7 +10,7 @@
 
 #include "bundletrack/core/execution.hpp"
 #include "bundletrack/features/opencv_features.hpp"
-#include "bundletrack/io/ycbineoat_sequence.hpp"
+#include "bundletrack/io/rgbd_sequence.hpp"
 #include "bundletrack/masks/propagated_masks.hpp"
 #include "bundletrack/registration/ransac.hpp"
 #include "bundletrack/residuals/dense_point_to_plane.hpp"
@@ -106,7 +106,10 @@ inline std::vector<ConfigEntry> configEntries(Config& c) {
   return {
       {"tracker", "type", textChoice(c.tracker, {"full", "coarse"}), 0, 0, "",
        "full: pose graph over keyframes (paper IV); coarse: frame-to-frame RANSAC only"},
-      {"depth", "scale", &c.sequence.depth_scale, 1e-6, 1.0, "m/unit", "metres per unit of the 16-bit depth images"},
+      {"sequence", "layout", enumChoice(c.sequence.layout, {{"auto", io::Layout::Auto}, {"ycbineoat", io::Layout::YcbInEoat}, {"tum", io::Layout::Tum}}), 0, 0, "",
+       "how the folder lists its frames: ycbineoat (rgb/, depth/ by name), tum (rgb.txt, depth.txt by time); auto: tum where rgb.txt and depth.txt exist"},
+      {"sequence", "max_time_difference", &c.sequence.max_time_difference, 0.0, 10.0, "s", "tum: a colour image's depth image is the nearest in time within this"},
+      {"depth", "scale", &c.sequence.depth_scale, 0.0, 1.0, "m/unit", "metres per unit of the 16-bit depth images; 0: the layout's (ycbineoat 0.001, tum 1/5000; numpy arrays 0.001)"},
       {"depth", "min_depth", &depth.min_depth, 0.0, 100.0, "m", "closer readings are invalid"},
       {"depth", "max_depth", &depth.max_depth, 0.0, inf, "m", "farther readings are invalid"},
       {"depth", "erode_radius", &depth.erode_radius, 0, 10, "px", "erosion neighbourhood radius (1: 3x3)"},

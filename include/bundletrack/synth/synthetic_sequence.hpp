@@ -15,6 +15,7 @@
 #include "bundletrack/core/error.hpp"
 #include "bundletrack/io/point_files.hpp"
 #include "bundletrack/io/pose_files.hpp"
+#include "bundletrack/io/sequence_layouts.hpp"
 #include "bundletrack/synth/renderer.hpp"
 #include "bundletrack/synth/sensor_model.hpp"
 #include "bundletrack/synth/trajectory.hpp"
@@ -194,27 +195,52 @@ inline void writeImage(const std::filesystem::path& path, const cv::Mat& image) 
 
 }  // namespace detail
 
-/// Writes frame i of `scene` under root with the name %06d.
-inline void writeFrame(const std::filesystem::path& root, const SyntheticScene& scene, int i) {
+/// The TUM RGB-D layout's timestamps of frame i: a 30 Hz colour stream, and depth 4 ms after
+/// it (the streams of a Kinect are not synchronised).
+inline double tumColorTime(int i) { return 1305031102.0 + i / 30.0; }
+inline double tumDepthTime(int i) { return tumColorTime(i) + 0.004; }
+
+inline std::string tumName(double time) {
+  char buffer[32];
+  std::snprintf(buffer, sizeof(buffer), "%.6f", time);
+  return buffer;
+}
+
+/// Writes frame i of `scene` under root: named %06d with depth in millimetres (YCBInEOAT), or by
+/// its timestamps with depth in 1/5000 m (TUM).
+inline void writeFrame(const std::filesystem::path& root, const SyntheticScene& scene, int i, io::Layout layout) {
   const SyntheticFrame frame = scene.frame(i);
+  const bool tum = layout == io::Layout::Tum;
   char buffer[16];
   std::snprintf(buffer, sizeof(buffer), "%06d", i);
-  const std::string name(buffer);
-  cv::Mat depth_mm;
-  frame.depth.convertTo(depth_mm, CV_16UC1, 1000.0);  // rounds to the nearest millimetre
+  const std::string name = tum ? tumName(tumColorTime(i)) : std::string(buffer);
+  cv::Mat depth_units;
+  frame.depth.convertTo(depth_units, CV_16UC1, tum ? 5000.0 : 1000.0);  // rounds to the nearest unit
   detail::writeImage(root / "rgb" / (name + ".png"), frame.color);
-  detail::writeImage(root / "depth" / (name + ".png"), depth_mm);
+  detail::writeImage(root / "depth" / ((tum ? tumName(tumDepthTime(i)) : name) + ".png"), depth_units);
   detail::writeImage(root / "masks" / (name + ".png"), frame.mask);
   io::writePose(root / "annotated_poses" / (name + ".txt"), frame.T_cam_obj);
 }
 
 /// Writes the sequence in the YCBInEOAT layout (rgb/, depth/ uint16 mm, masks/, annotated_poses/,
-/// cam_K.txt, model/points.xyz). Frames are rendered in parallel; the result depends only on the
-/// settings.
-inline void writeSyntheticSequence(const std::filesystem::path& root, const SyntheticSequenceSettings& settings) {
+/// cam_K.txt, model/points.xyz), or in the TUM RGB-D layout (the same with rgb.txt and depth.txt
+/// listing timestamped images, depth in 1/5000 m). Frames are rendered in parallel; the result
+/// depends only on the settings.
+inline void writeSyntheticSequence(const std::filesystem::path& root, const SyntheticSequenceSettings& settings,
+                                   io::Layout layout = io::Layout::YcbInEoat) {
   const SyntheticScene scene(settings);
   for (const char* dir : {"rgb", "depth", "masks", "annotated_poses", "model"})
     std::filesystem::create_directories(root / dir);
+  if (layout == io::Layout::Tum) {
+    std::ofstream rgb(root / "rgb.txt"), depth(root / "depth.txt");
+    rgb << "# color images\n# timestamp filename\n";
+    depth << "# depth maps\n# timestamp filename\n";
+    for (int i = 0; i < settings.frames; ++i) {
+      rgb << tumName(tumColorTime(i)) << " rgb/" << tumName(tumColorTime(i)) << ".png\n";
+      depth << tumName(tumDepthTime(i)) << " depth/" << tumName(tumDepthTime(i)) << ".png\n";
+    }
+    if (!rgb || !depth) throw InputError(root, "cannot write rgb.txt or depth.txt");
+  }
   {
     std::ofstream K(root / "cam_K.txt");
     K.precision(10);
@@ -227,7 +253,7 @@ inline void writeSyntheticSequence(const std::filesystem::path& root, const Synt
   std::exception_ptr first_error;
   cv::parallel_for_(cv::Range(0, settings.frames), [&](const cv::Range& range) {
     try {
-      for (int i = range.start; i < range.end; ++i) writeFrame(root, scene, i);
+      for (int i = range.start; i < range.end; ++i) writeFrame(root, scene, i, layout);
     } catch (...) {
       const std::lock_guard lock(error_mutex);
       if (!first_error) first_error = std::current_exception();

@@ -1,7 +1,5 @@
 #pragma once
 
-#include <algorithm>
-#include <cctype>
 #include <cmath>
 #include <filesystem>
 #include <optional>
@@ -15,71 +13,36 @@
 #include "bundletrack/io/intrinsics_file.hpp"
 #include "bundletrack/io/point_files.hpp"
 #include "bundletrack/io/pose_files.hpp"
+#include "bundletrack/io/sequence_layouts.hpp"
 
 namespace bundletrack::io {
 
 struct SequenceSettings {
-  double depth_scale = 0.001;  ///< metres per unit of the 16-bit depth images (0.001: millimetres)
+  /// Metres per unit of the 16-bit depth images; 0: the layout's own (YCBInEOAT 0.001, i.e.
+  /// millimetres; TUM RGB-D 1/5000).
+  double depth_scale = 0.0;
+  Layout layout = Layout::Auto;
+  double max_time_difference = 0.02;  ///< seconds between a TUM colour image and its depth (associate.py's default)
   FrameSettings frame;
 };
 
-/// The frames of a sequence: its colour images (rgb/*.png, *.jpg) in name order, numeric names
-/// compared as numbers. Throws InputError without any, or for two images of one name.
-struct ColorImages {
-  std::vector<std::string> names;  ///< file stems: the frames' names
-  std::vector<std::string> files;  ///< file names in rgb/
-};
-
-inline ColorImages listColorImages(const std::filesystem::path& root) {
-  const auto numericName = [](const std::string& s) {
-    return !s.empty() && std::all_of(s.begin(), s.end(), [](unsigned char c) { return std::isdigit(c); });
-  };
-  const auto dir = root / "rgb";
-  if (!std::filesystem::is_directory(dir)) throw InputError(dir, "directory not found");
-  ColorImages found;
-  for (const auto& entry : std::filesystem::directory_iterator(dir)) {
-    std::string ext = entry.path().extension().string();
-    std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
-    if (entry.is_regular_file() && (ext == ".png" || ext == ".jpg" || ext == ".jpeg")) {
-      found.names.push_back(entry.path().stem().string());
-      found.files.push_back(entry.path().filename().string());
-    }
-  }
-  if (found.names.empty()) throw InputError(dir, "no .png or .jpg colour images");
-  std::vector<std::size_t> order(found.names.size());
-  for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
-  std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
-    const std::string &x = found.names[a], &y = found.names[b];
-    if (numericName(x) && numericName(y) && x.size() != y.size()) return x.size() < y.size();
-    return x < y;
-  });
-  ColorImages sorted;
-  for (const std::size_t i : order) {
-    if (!sorted.names.empty() && sorted.names.back() == found.names[i])
-      throw InputError(dir, "two colour images share the name '" + found.names[i] + "'");
-    sorted.names.push_back(found.names[i]);
-    sorted.files.push_back(found.files[i]);
-  }
-  return sorted;
-}
-
-/// A sequence folder in the YCBInEOAT layout:
-///   rgb/<name>.png|jpg   colour          depth/<name>.png   uint16 depth
+/// A sequence folder, its frames listed by its layout (io/sequence_layouts.hpp: YCBInEOAT or TUM
+/// RGB-D), and beside them:
 ///   masks/<name>.png     object mask     (the first frame's is required, later ones optional)
 ///   cam_K.txt            3x3 intrinsics  annotated_poses/<name>.txt  4x4 T_cam_obj (optional)
 ///   model/points.xyz     object points in the object frame (optional)
-/// Frames are the colour images in name order (numeric names compared as numbers).
-class YcbineoatSequence {
+/// where <name> is a frame's colour image's file stem.
+class RgbdSequence {
  public:
-  explicit YcbineoatSequence(std::filesystem::path root, SequenceSettings settings = {})
+  explicit RgbdSequence(std::filesystem::path root, SequenceSettings settings = {})
       : root_(std::move(root)), settings_(std::move(settings)) {
     if (!std::filesystem::is_directory(root_)) throw InputError(root_, "sequence directory not found");
-    if (!(settings_.depth_scale > 0.0)) throw InputError(root_, "depth scale must be positive");
-    ColorImages images = listColorImages(root_);
-    names_ = std::move(images.names);
-    color_files_ = std::move(images.files);
+    if (!(settings_.depth_scale >= 0.0)) throw InputError(root_, "depth scale must be positive (or 0: the layout's)");
+    frames_ = frameFiles(root_, settings_.layout, settings_.max_time_difference);
+    depth_scale_ = settings_.depth_scale > 0.0 ? settings_.depth_scale : frames_.depth_unit;
+    if (const auto folder = depthPath(0).parent_path(); !depthPath(0).empty() && !std::filesystem::is_directory(folder))
+      throw InputError(folder, "directory not found");
     camera_ = readIntrinsics(root_ / "cam_K.txt");
-    if (!std::filesystem::is_directory(root_ / "depth")) throw InputError(root_ / "depth", "directory not found");
 
     const cv::Mat first_color = readColor(colorPath(0));
     image_size_ = first_color.size();
@@ -92,11 +55,12 @@ class YcbineoatSequence {
     const auto first_mask = mask(0);
     if (!first_mask) throw InputError(maskPath(0), "the first frame needs an object mask: file not found");
     if (cv::countNonZero(*first_mask) == 0) throw InputError(maskPath(0), "the first frame's object mask is empty");
-    checkDepthScale(rawDepth(0), *first_mask, settings_.depth_scale, depthPath(0));
+    checkDepthScale(rawDepth(0), *first_mask, depth_scale_, depthPath(0));
   }
 
-  std::size_t size() const { return names_.size(); }
-  const std::vector<std::string>& frameNames() const { return names_; }
+  std::size_t size() const { return frames_.names.size(); }
+  const std::vector<std::string>& frameNames() const { return frames_.names; }
+  double depthScale() const { return depth_scale_; }  ///< metres per unit, as used
   const std::filesystem::path& root() const { return root_; }
   const PinholeCamerad& camera() const { return camera_; }
   cv::Size imageSize() const { return image_size_; }
@@ -110,7 +74,7 @@ class YcbineoatSequence {
   RawFrame read(std::size_t i) const {
     cv::Mat color = readColor(colorPath(i));
     requireSize(color, colorPath(i));
-    return {names_.at(i), std::move(color), rawDepth(i), mask(i).value_or(cv::Mat())};
+    return {frames_.names.at(i), std::move(color), rawDepth(i), mask(i).value_or(cv::Mat())};
   }
 
   /// Preprocesses a frame from read(), only inside `region` (Tracker::regionOfInterest; empty:
@@ -122,7 +86,8 @@ class YcbineoatSequence {
   /// Depth of frame i in metres as stored, before filtering.
   cv::Mat rawDepth(std::size_t i) const {
     const auto path = depthPath(i);
-    const cv::Mat depth = readDepth(path, settings_.depth_scale);
+    if (path.empty()) throw InputError(colorPath(i), frames_.missing_depth.at(i));
+    const cv::Mat depth = readDepth(path, depth_scale_);
     requireSize(depth, path);
     if (cv::countNonZero(depth) == 0) throw InputError(path, "depth image has no valid pixel (all zero)");
     return depth;
@@ -138,12 +103,12 @@ class YcbineoatSequence {
   }
 
   /// Frame i's files (the mask's may not exist).
-  std::filesystem::path colorPath(std::size_t i) const { return root_ / "rgb" / color_files_.at(i); }
-  std::filesystem::path depthPath(std::size_t i) const { return root_ / "depth" / (names_.at(i) + ".png"); }
-  std::filesystem::path maskPath(std::size_t i) const { return root_ / "masks" / (names_.at(i) + ".png"); }
+  std::filesystem::path colorPath(std::size_t i) const { return frames_.color.at(i); }
+  std::filesystem::path depthPath(std::size_t i) const { return frames_.depth.at(i); }  ///< empty: none
+  std::filesystem::path maskPath(std::size_t i) const { return root_ / "masks" / (frames_.names.at(i) + ".png"); }
 
   bool hasGroundTruth() const { return std::filesystem::is_directory(root_ / "annotated_poses"); }
-  SE3d groundTruthPose(std::size_t i) const { return readPose(root_ / "annotated_poses" / (names_.at(i) + ".txt")); }
+  SE3d groundTruthPose(std::size_t i) const { return readPose(root_ / "annotated_poses" / (frames_.names.at(i) + ".txt")); }
 
   bool hasModel() const { return std::filesystem::is_regular_file(modelPath()); }
   std::vector<Eigen::Vector3f> modelPoints() const { return readPoints(modelPath()); }
@@ -160,8 +125,8 @@ class YcbineoatSequence {
 
   std::filesystem::path root_;
   SequenceSettings settings_;
-  std::vector<std::string> names_;
-  std::vector<std::string> color_files_;
+  FrameFiles frames_;
+  double depth_scale_ = 0.001;
   PinholeCamerad camera_;
   cv::Size image_size_;
 };
