@@ -10,6 +10,7 @@
 #include <cstring>
 #include <fstream>
 #include <iostream>
+#include <limits>
 #include <string>
 #include <system_error>
 #include <variant>
@@ -195,10 +196,12 @@ int run(bt::AnyTracker& tracker, const bt::io::RgbdSequence& sequence, const Opt
   std::optional<OverlayWriter> overlay;
   if (options.viz) overlay.emplace(options.out, sequence);
   std::vector<double> rotation_errors, translation_errors, mask_ious, total_ms, read_ms_all, features_ms;
+  std::vector<bool> lost_scored;  // per scored frame, for the error plot
   // Files are decoded a few frames ahead on another thread; each frame is preprocessed only where
   // the tracker will look (Tracker::regionOfInterest).
   bt::io::ReadAhead<bt::RawFrame> files(sequence.size(), [&](std::size_t i) { return sequence.read(i); });
-  bt::Stopwatch whole_run;
+  bt::Stopwatch whole_run, progress;
+  double elapsed_ms = 0.0, shown_ms = -1e9;  // since the start, and when the progress line was drawn
   for (std::size_t i = 0; i < sequence.size(); ++i) {
     bt::Stopwatch reading;
     // A frame whose files cannot be read (or, with given masks, has no mask) is reported lost with
@@ -259,6 +262,7 @@ int run(bt::AnyTracker& tracker, const bt::io::RgbdSequence& sequence, const Opt
                                                                               : std::nullopt);
         rotation_errors.push_back(bt::rotationErrorDeg(*true_pose, result.T_cam_obj));
         translation_errors.push_back(100.0 * bt::translationError(*true_pose, result.T_cam_obj));
+        lost_scored.push_back(result.status == bt::TrackStatus::Lost);
         csv << rotation_errors.back() << ',' << translation_errors.back();
       } else {
         csv << ',';
@@ -278,11 +282,18 @@ int run(bt::AnyTracker& tracker, const bt::io::RgbdSequence& sequence, const Opt
       overlay->add(i, *frame, result);
     }
     csv << ',' << csvField(problem) << '\n';
-    // On a terminal one line updated in place; in a log a line every 50 frames.
-    if (!options.quiet && (interactive || (i + 1) % 50 == 0 || i + 1 == sequence.size()))
-      std::fprintf(stderr, "%sframe %zu/%zu  %-7s  inliers %3d/%-3d  %.1f ms%s", interactive ? "\r" : "", i + 1,
-                   sequence.size(), std::string(bt::statusName(result.status)).c_str(), result.inliers,
-                   result.matches, t.total, interactive ? " " : "\n");
+    // Progress: on a terminal one line redrawn ten times a second, in a log a line every 50 frames;
+    // the rate and the time left from the frames so far.
+    elapsed_ms += progress.lap();
+    const bool last = i + 1 == sequence.size();
+    if (!options.quiet && (interactive ? elapsed_ms - shown_ms >= 100.0 || last : (i + 1) % 50 == 0 || last)) {
+      shown_ms = elapsed_ms;
+      const double per_frame_ms = elapsed_ms / double(i + 1);
+      std::fprintf(stderr, "%sframe %zu/%zu  %-7s  inliers %3d/%-3d  %5.1f ms  |  %.1f fps, %d lost, %.0f s left%s",
+                   interactive ? "\r" : "", i + 1, sequence.size(), std::string(bt::statusName(result.status)).c_str(),
+                   result.inliers, result.matches, t.total, 1000.0 / per_frame_ms, lost,
+                   per_frame_ms * double(sequence.size() - i - 1) / 1000.0, interactive ? "   " : "\n");
+    }
   }
   const double run_ms = whole_run.lap();  // frames 1 .. n-1 with writing the results
   if (!options.quiet && interactive) std::fprintf(stderr, "\n");
@@ -331,8 +342,16 @@ int run(bt::AnyTracker& tracker, const bt::io::RgbdSequence& sequence, const Opt
     std::printf("overlay: %s\n", overlay->finish().c_str());
     if (scored) {
       const fs::path plot = options.out / "errors.png";
-      cv::imwrite(plot.string(), bt::viz::plotSeries(rotation_errors, "rotation error [deg]", translation_errors,
-                                                     "translation error [cm]"));
+      // A lost frame keeps the last pose, which the tracker does not stand behind: a gap, shaded.
+      const auto unless_lost = [&](std::vector<double> errors) {
+        for (std::size_t k = 0; k < errors.size(); ++k)
+          if (lost_scored[k]) errors[k] = std::numeric_limits<double>::quiet_NaN();
+        return errors;
+      };
+      const cv::Mat errors = bt::viz::plotErrors({{"rotation error [deg]", unless_lost(rotation_errors)},
+                                                  {"translation error [cm]", unless_lost(translation_errors)}},
+                                                 lost_scored);
+      if (!cv::imwrite(plot.string(), errors)) throw bt::InputError(plot, "cannot write image");
       std::printf("error plot: %s\n", plot.string().c_str());
     }
   }

@@ -6,6 +6,7 @@
 
 #include "bundletrack/eval/score_table.hpp"
 #include "bundletrack/eval/sequence_score.hpp"
+#include "bundletrack/viz/overlay.hpp"
 
 namespace bt = bundletrack;
 
@@ -91,4 +92,25 @@ TEST_CASE("frames without an estimate count as failures") {
   const std::string table = bt::formatScoreTable({{"none", none}});
   CHECK(table.find("n/a") != std::string::npos);
   CHECK(table.find("0.00dg") == std::string::npos);
+}
+
+TEST_CASE("error plot: ticks at 1, 2 or 5 times a power of ten, one panel per series") {
+  const auto check = [](double peak, double step, double end) {
+    const bundletrack::viz::Ticks t = bundletrack::viz::niceTicks(peak);
+    CAPTURE(peak);
+    CHECK(t.step == doctest::Approx(step));
+    CHECK(t.end == doctest::Approx(end));
+  };
+  check(0.44, 0.1, 0.5);
+  check(24.86, 5.0, 25.0);
+  check(201.26, 50.0, 250.0);
+  check(1.0, 0.2, 1.0);
+  check(7.0, 2.0, 8.0);
+  check(0.0, 1.0, 1.0);  // nothing to show: a unit axis
+  CHECK(bundletrack::viz::niceTicks(99.0, 10).step == doctest::Approx(10.0));
+  const std::vector<double> errors = {0.1, 0.2, std::nan(""), 0.4};
+  const cv::Mat plot = bundletrack::viz::plotErrors({{"a [deg]", errors}, {"b [cm]", errors}}, {false, false, true, false});
+  CHECK(plot.cols == 900);
+  CHECK(plot.rows == 34 + 2 * 220 + 40 + 46);
+  CHECK(cv::countNonZero(plot.reshape(1) != 255) > 0);
 }

@@ -1,6 +1,7 @@
 #pragma once
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <string>
 #include <vector>
@@ -55,30 +56,97 @@ inline void drawBox(cv::Mat& bgr, const PinholeCamerad& camera, const SE3d& T_ca
   }
 }
 
-/// A line plot of one or two series over frames (e.g. rotation error in degrees and translation
-/// error in cm), each scaled to its own maximum, with the maxima printed in the series' colour.
-inline cv::Mat plotSeries(const std::vector<double>& a, const std::string& a_label, const std::vector<double>& b,
-                          const std::string& b_label, cv::Size size = {900, 360}) {
-  cv::Mat plot(size, CV_8UC3, cv::Scalar::all(255));
-  const int left = 60, right = 20, top = 40, bottom = 40;
-  const cv::Rect area(left, top, size.width - left - right, size.height - top - bottom);
-  cv::rectangle(plot, area, cv::Scalar::all(0));
-  const auto draw = [&](const std::vector<double>& v, const std::string& label, const cv::Scalar& colour, int row) {
-    if (v.empty()) return;
-    double peak = 1e-9;
-    for (const double x : v) peak = std::max(peak, x);
-    std::vector<cv::Point> line;
-    for (std::size_t i = 0; i < v.size(); ++i)
-      line.emplace_back(area.x + int(double(i) / std::max<std::size_t>(1, v.size() - 1) * area.width),
-                        area.y + area.height - int(v[i] / peak * area.height));
-    cv::polylines(plot, line, false, colour, 2, cv::LINE_AA);
-    char text[128];
-    std::snprintf(text, sizeof(text), "%s (max %.2f)", label.c_str(), peak);
-    cv::putText(plot, text, {left + 10 + 400 * row, 25}, cv::FONT_HERSHEY_SIMPLEX, 0.6, colour, 1, cv::LINE_AA);
+/// Axis ticks for values in [0, peak]: a step of 1, 2 or 5 times a power of ten giving at most
+/// `most` intervals, and the axis' end, the first multiple of the step at or above peak.
+struct Ticks {
+  double step, end;
+};
+inline Ticks niceTicks(double peak, int most = 5) {
+  if (!(peak > 0.0) || !std::isfinite(peak)) return {1.0, 1.0};
+  const double raw = peak / most, power = std::pow(10.0, std::floor(std::log10(raw)));
+  double step = 10.0 * power;
+  for (const double m : {1.0, 2.0, 5.0})
+    if (m * power >= raw * (1.0 - 1e-9)) {
+      step = m * power;
+      break;
+    }
+  return {step, step * std::ceil(peak / step - 1e-9)};
+}
+
+/// One labelled series of a plot over frames.
+struct Series {
+  std::string title;  ///< with its unit, e.g. "rotation error [deg]"
+  std::vector<double> values;  ///< per frame; NaN: no value (drawn as a gap)
+};
+
+/// Errors over a sequence as a person reads them: one panel per series stacked over a shared frame
+/// axis, each with its own y axis from 0 (ticks labelled in the series' unit, grid lines), its
+/// title with mean and maximum, frame numbers on the x axis, and the frames in `lost` (true:
+/// lost) shaded grey, named in the legend.
+inline cv::Mat plotErrors(const std::vector<Series>& series, const std::vector<bool>& lost = {}, int width = 900,
+                          int panel_height = 220) {
+  const int left = 70, right = 20, top = 34, bottom = 46, gap = 40;
+  const int count = int(series.size());
+  cv::Mat plot(top + count * panel_height + (count - 1) * gap + bottom, width, CV_8UC3, cv::Scalar::all(255));
+  std::size_t frames = 0;
+  for (const Series& s : series) frames = std::max(frames, s.values.size());
+  if (frames == 0) return plot;
+  const int plot_width = width - left - right;
+  const auto x_of = [&](double frame) { return left + int(std::lround(frame / double(std::max<std::size_t>(1, frames - 1)) * plot_width)); };
+  const cv::Scalar ink = cv::Scalar::all(0), grid = cv::Scalar::all(225), shade = cv::Scalar::all(200);
+  const auto text = [&](const std::string& t, cv::Point at, double scale, const cv::Scalar& colour) {
+    cv::putText(plot, t, at, cv::FONT_HERSHEY_SIMPLEX, scale, colour, 1, cv::LINE_AA);
   };
-  draw(a, a_label, {40, 40, 220}, 0);
-  draw(b, b_label, {200, 90, 20}, 1);
-  cv::putText(plot, "frame", {size.width / 2 - 20, size.height - 12}, cv::FONT_HERSHEY_SIMPLEX, 0.5, cv::Scalar::all(0));
+  const auto label = [](double value, double step) {
+    char buffer[32];
+    std::snprintf(buffer, sizeof(buffer), "%.*f", std::max(0, int(std::ceil(-std::log10(step) - 1e-9))), value);
+    return std::string(buffer);
+  };
+  const Ticks frame_ticks = niceTicks(double(frames - 1), 10);
+  const cv::Scalar colours[] = {{40, 40, 220}, {200, 90, 20}, {40, 150, 40}};
+  for (int k = 0; k < count; ++k) {
+    const Series& s = series[std::size_t(k)];
+    const cv::Rect area(left, top + k * (panel_height + gap), plot_width, panel_height);
+    for (std::size_t i = 0; i < lost.size() && i < frames; ++i)  // lost frames: a grey band each
+      if (lost[i]) cv::rectangle(plot, cv::Rect(x_of(double(i)) - 1, area.y, std::max(2, plot_width / int(frames)), area.height), shade, cv::FILLED);
+    double peak = 0.0, sum = 0.0;
+    int present = 0;
+    for (const double v : s.values)
+      if (std::isfinite(v)) peak = std::max(peak, v), sum += v, ++present;
+    const Ticks ticks = niceTicks(peak);
+    for (double y = 0.0; y <= ticks.end * (1.0 + 1e-9); y += ticks.step) {
+      const int row = area.y + area.height - int(std::lround(y / ticks.end * area.height));
+      cv::line(plot, {area.x, row}, {area.x + area.width, row}, grid);
+      const std::string t = label(y, ticks.step);
+      text(t, {area.x - 8 - 9 * int(t.size()), row + 5}, 0.45, ink);
+    }
+    for (double f = 0.0; f <= double(frames - 1) + 1e-9; f += frame_ticks.step) {
+      cv::line(plot, {x_of(f), area.y + area.height}, {x_of(f), area.y + area.height + 5}, ink);
+      if (k == count - 1) text(label(f, 1.0), {x_of(f) - 10, area.y + area.height + 20}, 0.45, ink);
+    }
+    std::vector<cv::Point> line;
+    const auto flush = [&] {
+      if (line.size() > 1) cv::polylines(plot, line, false, colours[k % 3], 2, cv::LINE_AA);
+      line.clear();
+    };
+    for (std::size_t i = 0; i < s.values.size(); ++i) {
+      if (!std::isfinite(s.values[i])) {
+        flush();
+        continue;
+      }
+      line.emplace_back(x_of(double(i)), area.y + area.height - int(std::lround(s.values[i] / ticks.end * area.height)));
+    }
+    flush();
+    cv::rectangle(plot, area, ink);
+    char title[160];
+    std::snprintf(title, sizeof(title), "%s   mean %.2f, max %.2f", s.title.c_str(), present ? sum / present : 0.0, peak);
+    text(title, {area.x, area.y - 10}, 0.55, colours[k % 3]);
+  }
+  text("frame", {left + plot_width / 2 - 20, plot.rows - 8}, 0.5, ink);
+  if (std::find(lost.begin(), lost.end(), true) != lost.end()) {
+    cv::rectangle(plot, cv::Rect(width - right - 120, plot.rows - 22, 14, 12), shade, cv::FILLED);
+    text("lost frames", {width - right - 100, plot.rows - 12}, 0.45, ink);
+  }
   return plot;
 }
 
