@@ -127,7 +127,17 @@ TEST_CASE("bad input raises InputError naming the file and the problem") {
   }
   SUBCASE("unreadable colour image") {
     writeText(root / "rgb" / "2.png", "not a png");
+    checkInputError([&] { open().frame(1); }, root / "rgb" / "2.png", "not a PNG or JPEG image");
+  }
+  SUBCASE("a PNG header over garbage") {
+    writeText(root / "rgb" / "2.png", std::string("\x89PNG\r\n\x1a\n", 8) + "garbage IEND");
     checkInputError([&] { open().frame(1); }, root / "rgb" / "2.png", "cannot decode");
+  }
+  SUBCASE("another format's file: OpenCV's DICOM decoder aborted on this one (fuzz_sequence_files)") {
+    std::string dicom(128, '\xff');
+    dicom += "DICM\xffUN";
+    writeText(root / "depth" / "2.png", dicom);
+    checkInputError([&] { open().frame(1); }, root / "depth" / "2.png", "not a PNG or JPEG image");
   }
   // Truncated files still decode (the rest grey or black) unless their end marker is checked.
   const auto truncate = [](const fs::path& path) { fs::resize_file(path, fs::file_size(path) / 2); };

@@ -41,10 +41,21 @@ inline bool endsComplete(const std::vector<uchar>& bytes) {
   return true;
 }
 
+/// Whether the bytes start as a PNG or a JPEG file does.
+inline bool isPngOrJpeg(const std::vector<uchar>& bytes) {
+  const auto startsWith = [&](std::initializer_list<uchar> magic) {
+    return bytes.size() >= magic.size() && std::equal(magic.begin(), magic.end(), bytes.begin());
+  };
+  return startsWith({0xFF, 0xD8, 0xFF}) || startsWith({0x89, 'P', 'N', 'G', 0x0D, 0x0A, 0x1A, 0x0A});
+}
+
 /// Decodes an encoded image (the bytes of `path`); an empty, truncated or undecodable one is an
-/// InputError.
+/// InputError, and so is any format but PNG and JPEG (the layouts' formats): OpenCV picks a
+/// decoder by the content, and some abort the process on malformed input (its DICOM reader
+/// asserts, found by fuzz_sequence_files).
 inline cv::Mat decodeImage(const std::vector<uchar>& bytes, int flags, const std::filesystem::path& path) {
   if (bytes.empty()) throw InputError(path, "empty file");
+  if (!isPngOrJpeg(bytes)) throw InputError(path, "not a PNG or JPEG image (images must be .png or .jpg)");
   if (!endsComplete(bytes))
     throw InputError(path, "truncated or corrupt image: it ends without its format's end marker (" +
                                std::to_string(bytes.size()) + " bytes)");
