@@ -29,6 +29,10 @@ const char* const kUsage = R"(usage: bundletrack_synth --out DIR [options]
                      (RealSense D4xx) | time_of_flight (Azure Kinect) (structured_light;
                      bundletrack::DepthNoise)
   --no-noise         perfect sensor: no depth noise, quantisation, dropouts or colour noise
+  --objects N        1 | 2 | 3 objects, each carried by its own hand: beside the --shape the first
+                     of box, cylinder, mug it is not, passing in front of and behind it; their
+                     masks, poses and models go to masks/<shape>/, annotated_poses/<shape>/ and
+                     model/<shape>/ (1)
   --seed N           random seed of textures and sensor noise (1)
   --layout L         ycbineoat (rgb/%06d.png, depth in mm) | tum (rgb.txt, depth.txt: 30 Hz timestamps,
                      depth 4 ms after colour, in 1/5000 m) (ycbineoat)
@@ -104,6 +108,10 @@ int main(int argc, char** argv) {
       else fail("unknown sensor '" + sensor + "' (structured_light | active_stereo | time_of_flight)");
     } else if (arg == "--no-noise") {
       settings.sensor = bt::synth::SensorSettings::perfect();
+    } else if (arg == "--objects") {
+      const double objects = number(arg, value());
+      if (objects != 1.0 && objects != 2.0 && objects != 3.0) fail("--objects must be 1, 2 or 3");
+      settings.objects = int(objects);
     } else if (arg == "--seed") {
       settings.seed = unsigned(number(arg, value()));
     } else if (arg == "--layout") {

@@ -1,8 +1,9 @@
 // bundletrack_track --sequence DIR --out DIR [options]
-// Tracks the object of a YCBInEOAT-layout sequence from its first pose and its masks (every
-// frame's, or with --propagate-masks the first one only); writes OUT/poses/<frame>.txt (4x4
-// T_cam_obj) and OUT/track.csv, and prints the accuracy when the sequence has ground truth and a
-// model, and the propagated masks' IoU when it has masks.
+// Tracks the object of a sequence (YCBInEOAT or TUM RGB-D layout) from its first pose and its
+// masks (every frame's, or with --propagate-masks the first one only); writes
+// OUT/poses/<frame>.txt (4x4 T_cam_obj) and OUT/track.csv, and prints the accuracy when the
+// sequence has ground truth and a model, and the propagated masks' IoU when it has masks. A
+// sequence of several objects (a folder of masks per object) gets OUT/<object>/ for each.
 #include <algorithm>
 #include <cmath>
 #include <cerrno>
@@ -11,6 +12,8 @@
 #include <fstream>
 #include <iostream>
 #include <limits>
+#include <memory>
+#include <sstream>
 #include <string>
 #include <system_error>
 #include <variant>
@@ -27,6 +30,7 @@
 #include "bundletrack/io/model_file.hpp"
 #include "bundletrack/io/read_ahead.hpp"
 #include "bundletrack/runtime/make_tracker.hpp"
+#include "bundletrack/tracking/multi_object_tracker.hpp"
 #include "bundletrack/tracking/stopwatch.hpp"
 #include "bundletrack/viz/overlay.hpp"
 
@@ -60,6 +64,13 @@ const char* const kUsage = R"(usage: bundletrack_track --sequence DIR --out DIR 
                      a reading, no mask with given masks, no annotated pose) stops the run; by
                      default it is reported lost with the reason (track.csv: problem) and the run
                      goes on, the frame scored as a failure (without an annotated pose: not scored)
+  --objects LIST     a sequence of several objects (masks/<object>/<frame>.png, one folder per
+                     object; annotated_poses/<object>/ and model/<object>/ likewise): the objects
+                     to track, names separated by commas, or all (all). Each is tracked by its own
+                     tracker from the first frame with a non-empty mask of it, at its annotated pose
+                     there (else the identity), the frames read and preprocessed once for all of
+                     them; the outputs go to OUT/<object>/ (poses/, track.csv, model.ply,
+                     errors.png), the overlay shows them all
   --quiet            no progress line
 )";
 
@@ -91,10 +102,43 @@ double number(const std::string& option, const std::string& text) {
 
 struct Options {
   fs::path sequence, out, config_file;
+  std::string objects;  ///< --objects: names separated by commas, or "all"
   bt::Config config;
   bool quiet = false;
   bool strict = false;  ///< --strict: a frame that cannot be read stops the run
   bool viz = false;
+};
+
+/// The objects --objects names ("" or "all": every one), checked against the sequence's; {""}
+/// for a sequence of one object.
+std::vector<std::string> chosenObjects(const bt::io::RgbdSequence& sequence, const std::string& list) {
+  const std::vector<std::string>& available = sequence.objects();
+  std::string names;
+  for (const std::string& name : available) names += (names.empty() ? "" : ", ") + name;
+  if (available.empty()) {
+    if (!list.empty())
+      fail("--objects " + list + ": " + (sequence.root() / "masks").string() +
+           " holds the masks of one object (masks/<frame>.png), not a folder per object");
+    return {""};
+  }
+  if (list.empty() || list == "all") return available;
+  std::vector<std::string> chosen;
+  std::stringstream items(list);
+  for (std::string name; std::getline(items, name, ',');) {
+    if (std::find(available.begin(), available.end(), name) == available.end())
+      fail("--objects: no object '" + name + "' in " + (sequence.root() / "masks").string() + " (it has " + names + ")");
+    if (std::find(chosen.begin(), chosen.end(), name) != chosen.end()) fail("--objects names '" + name + "' twice");
+    chosen.push_back(name);
+  }
+  if (chosen.empty()) fail("--objects needs at least one name (it has " + names + ")");
+  return chosen;
+}
+
+/// One object as the overlay draws it.
+struct DrawnObject {
+  std::string label;  ///< "" for a single object
+  const bt::TrackResult* result;  ///< none: the object has not started
+  const std::optional<bt::ObjectBox>* box;
 };
 
 /// The overlays of --viz: a video when an encoder is available, and a strip of six frames.
@@ -102,22 +146,33 @@ class OverlayWriter {
  public:
   OverlayWriter(const fs::path& out, const bt::io::RgbdSequence& sequence)
       : out_(out), camera_(sequence.camera()), frames_(sequence.size()) {
-    if (sequence.hasModel()) box_ = bt::ObjectBox::bounding(sequence.modelPoints());
     video_.open((out / "overlay.mp4").string(), cv::VideoWriter::fourcc('m', 'p', '4', 'v'), 10.0, sequence.imageSize());
   }
 
-  void add(std::size_t i, const bt::RgbdFrame& frame, const bt::TrackResult& result) {
+  /// Frame i with each object's mask outline, box and axes (an object's own colour when several).
+  void add(std::size_t i, const bt::RgbdFrame& frame, const std::vector<DrawnObject>& objects) {
+    static const cv::Scalar kColours[] = {{0, 220, 0}, {255, 160, 0}, {200, 0, 255}, {0, 200, 255}};
     cv::Mat image = frame.color.clone();
-    if (!frame.mask.empty()) bt::viz::drawMaskContour(image, frame.mask, {0, 255, 255});
-    double axis = 0.05;
-    if (box_) {
-      bt::viz::drawBox(image, camera_, result.T_cam_obj, *box_, {0, 220, 0}, 2);
-      axis = 0.6 * (box_->max - box_->min).maxCoeff();
+    std::string caption = frame.name;
+    bool any_lost = false;
+    for (std::size_t k = 0; k < objects.size(); ++k) {
+      const DrawnObject& object = objects[k];
+      const std::string status = object.result ? std::string(bt::statusName(object.result->status)) : "not started";
+      caption += "  " + (object.label.empty() ? status : object.label + " " + status);
+      if (!object.result) continue;
+      const bt::TrackResult& result = *object.result;
+      any_lost = any_lost || result.status == bt::TrackStatus::Lost;
+      const cv::Scalar colour = objects.size() == 1 ? kColours[0] : kColours[k % std::size(kColours)];
+      if (!result.mask.empty()) bt::viz::drawMaskContour(image, result.mask, objects.size() == 1 ? cv::Scalar(0, 255, 255) : colour);
+      double axis = 0.05;
+      if (*object.box) {
+        bt::viz::drawBox(image, camera_, result.T_cam_obj, **object.box, colour, 2);
+        axis = 0.6 * ((*object.box)->max - (*object.box)->min).maxCoeff();
+      }
+      bt::viz::drawAxes(image, camera_, result.T_cam_obj, axis);
     }
-    bt::viz::drawAxes(image, camera_, result.T_cam_obj, axis);
-    const bool lost = result.status == bt::TrackStatus::Lost;
-    cv::putText(image, frame.name + "  " + std::string(bt::statusName(result.status)), {10, 25},
-                cv::FONT_HERSHEY_SIMPLEX, 0.7, lost ? cv::Scalar(0, 0, 255) : cv::Scalar(255, 255, 255), 2, cv::LINE_AA);
+    cv::putText(image, caption, {10, 25}, cv::FONT_HERSHEY_SIMPLEX, 0.7, any_lost ? cv::Scalar(0, 0, 255) : cv::Scalar(255, 255, 255),
+                2, cv::LINE_AA);
     if (video_.isOpened()) video_.write(image);
     if (i % std::max<std::size_t>(1, frames_ / 6) == 0 && strip_.size() < 6) {
       cv::Mat half;
@@ -140,7 +195,6 @@ class OverlayWriter {
   fs::path out_;
   bt::PinholeCamerad camera_;
   std::size_t frames_;
-  std::optional<bt::ObjectBox> box_;
   cv::VideoWriter video_;
   std::vector<cv::Mat> strip_;
 };
@@ -158,130 +212,293 @@ std::string csvField(const std::string& text) {
   return quoted + "\"";
 }
 
-/// Makes OUT/poses (and OUT/masks) and checks that files can be written there, before any work:
+/// Makes `out` with its `folders` and checks that files can be written there, before any work:
 /// --out naming a file, a place without permission, a link loop or a name too long is said so.
-void prepareOutput(const fs::path& out, bool masks) {
+void prepareOutput(const fs::path& out, std::vector<fs::path> folders) {
+  folders.insert(folders.begin(), ".");
   std::error_code error;
   const fs::file_status status = fs::status(out, error);
   if (error && status.type() != fs::file_type::not_found)
     throw bt::InputError(out, "--out cannot be used: " + error.message());
   if (fs::exists(status) && !fs::is_directory(status))
     throw bt::InputError(out, "--out names a file, not a directory (the poses, track.csv and plots go into it)");
-  for (const char* folder : {"poses", masks ? "masks" : nullptr}) {
-    if (!folder) continue;
+  for (const fs::path& folder : folders) {
     fs::create_directories(out / folder, error);
     if (error) throw bt::InputError(out / folder, "--out: cannot create the directory: " + error.message());
   }
-  const fs::path probe = out / "poses" / ".write_test";
+  const fs::path probe = out / ".write_test";
   if (!std::ofstream(probe)) throw bt::InputError(out, std::string("--out is not writable: ") + std::strerror(errno));
   fs::remove(probe, error);
 }
 
-int run(bt::AnyTracker& tracker, const bt::io::RgbdSequence& sequence, const Options& options) {
-  std::ofstream csv(options.out / "track.csv");
-  const bool scored = sequence.hasGroundTruth() && sequence.hasModel();
-  // Read before the work: a model that cannot be read (empty, not numbers) stops the run now, not
-  // after every frame was tracked.
-  const std::vector<Eigen::Vector3f> model = scored ? sequence.modelPoints() : std::vector<Eigen::Vector3f>();
+/// What a run writes and reports of one object: in OUT itself for the only object of a sequence,
+/// in OUT/<object> for each of several -- poses/<frame>.txt, track.csv, masks/ (propagated masks),
+/// model.ply, errors.png -- and its tallies for the summary.
+class ObjectOutput {
+ public:
+  ObjectOutput(std::string object, fs::path out, const bt::io::RgbdSequence& sequence, const Options& options)
+      : object_(std::move(object)), out_(std::move(out)), sequence_(sequence),
+        propagated_(options.config.masks == "propagated"), strict_(options.strict),
+        scored_(sequence.hasGroundTruth(object_) && sequence.hasModel(object_)) {
+    // Read before the work: a model that cannot be read (empty, not numbers) stops the run now, not
+    // after every frame was tracked.
+    if (scored_ || (options.viz && sequence.hasModel(object_))) {
+      model_ = sequence.modelPoints(object_);
+      box_ = bt::ObjectBox::bounding(model_);
+    }
+    csv_.open(out_ / "track.csv");
+    csv_ << "frame,status,by_surface,keypoints,matches,inliers,read_ms,mask_ms,features_ms,matching_ms,ransac_ms,graph_ms,solve_ms,"
+            "total_ms"
+         << (scored_ ? ",rotation_error_deg,translation_error_cm" : "") << (propagated_ ? ",mask_iou" : "") << ",problem\n";
+  }
+
+  const std::string& object() const { return object_; }
+  const std::optional<bt::ObjectBox>& box() const { return box_; }
+  int lost() const { return lost_; }
+
+  /// Records frame i of the object: the tracker's result, or none when it has not started (an
+  /// object that sat the frame out because its data could not be read -- `problem` says why --
+  /// is lost and keeps its last pose); `dataset_mask` is the data's mask, for the IoU of
+  /// propagated masks. Returns what was recorded.
+  std::optional<bt::TrackResult> record(std::size_t i, std::optional<bt::TrackResult> result, bool started,
+                                        std::string problem, double read_ms, const cv::Mat& dataset_mask) {
+    const std::string name = sequence_.frameNames()[i];
+    const bool readable = problem.empty();
+    if (!result && !started) {
+      csv_ << name << ",not_started" << std::string(12 + (scored_ ? 2 : 0) + (propagated_ ? 1 : 0), ',') << ','
+           << csvField(problem) << '\n';
+      return result;
+    }
+    if (!result) {
+      result.emplace();
+      result->T_cam_obj = last_pose_;
+      result->status = bt::TrackStatus::Lost;
+      if (unreadable_++ == 0) first_unreadable_ = problem;
+    }
+    const bool first = !first_frame_;
+    if (first) first_frame_ = i;
+    last_pose_ = result->T_cam_obj;
+    lost_ += result->status == bt::TrackStatus::Lost;
+    by_surface_ += result->surface_only;
+    ++frames_;
+    bt::io::writePose(out_ / "poses" / (name + ".txt"), result->T_cam_obj);
+    const auto& t = result->timings;
+    csv_ << name << ',' << bt::statusName(result->status) << ',' << result->surface_only << ',' << result->keypoints << ','
+         << result->matches << ',' << result->inliers << ',' << read_ms << ',' << t.mask << ',' << t.features << ','
+         << t.matching << ',' << t.ransac << ',' << t.graph << ',' << t.solve << ',' << t.total;
+    if (scored_) {
+      // A frame without an annotated pose is not scored; one that could not be read scores as a failure.
+      std::optional<bt::SE3d> true_pose;
+      try {
+        true_pose = sequence_.groundTruthPose(i, object_);
+      } catch (const bt::InputError& error) {
+        if (first || strict_) throw;
+        ++unscored_;
+        if (problem.empty()) problem = std::string(error.what()) + " (frame not scored)";
+      }
+      csv_ << ',';
+      if (true_pose) {
+        truth_.push_back(*true_pose);
+        estimate_.push_back(readable ? std::optional(result->T_cam_obj) : std::nullopt);
+        estimate_unless_lost_.push_back(result->status != bt::TrackStatus::Lost ? std::optional(result->T_cam_obj)
+                                                                                : std::nullopt);
+        rotation_errors_.push_back(bt::rotationErrorDeg(*true_pose, result->T_cam_obj));
+        translation_errors_.push_back(100.0 * bt::translationError(*true_pose, result->T_cam_obj));
+        lost_scored_.push_back(result->status == bt::TrackStatus::Lost);
+        csv_ << rotation_errors_.back() << ',' << translation_errors_.back();
+      } else {
+        csv_ << ',';
+      }
+    }
+    if (propagated_) {
+      // A frame lost before a mask was made counts as an empty mask.
+      const cv::Mat used = result->mask.empty() ? cv::Mat::zeros(sequence_.imageSize(), CV_8UC1) : result->mask;
+      const fs::path mask_path = out_ / "masks" / (name + ".png");
+      if (!cv::imwrite(mask_path.string(), used)) throw bt::InputError(mask_path, "cannot write image");
+      if (!dataset_mask.empty()) mask_ious_.push_back(bt::maskIoU(used > 0, dataset_mask > 0));
+      csv_ << ',';
+      if (!dataset_mask.empty()) csv_ << mask_ious_.back();
+    }
+    csv_ << ',' << csvField(problem) << '\n';
+    return result;
+  }
+
+  /// The object's lines of the summary (the first after `heading`, the others after `prefix`), and its model.
+  void report(const std::string& heading, const std::string& prefix, const bt::AnyTracker& tracker) const {
+    const char* p = prefix.c_str();
+    if (!first_frame_) {
+      std::printf("%s no frame has a non-empty mask of this object: not tracked\n", heading.c_str());
+      return;
+    }
+    std::printf("%s %d frames%s, %d lost; poses in %s\n", heading.c_str(), frames_,
+                *first_frame_ > 0 ? (" from frame " + sequence_.frameNames()[*first_frame_]).c_str() : "", lost_,
+                (out_ / "poses").string().c_str());
+    if (unreadable_ > 0)
+      std::printf("%s%d of the lost frames could not be read (first: %s); the reasons are in track.csv's problem column\n",
+                  p, unreadable_, first_unreadable_.c_str());
+    if (unscored_ > 0) std::printf("%s%d frames without an annotated pose were not scored\n", p, unscored_);
+    if (by_surface_ > 0)
+      std::printf("%s%d frames tracked by the dense term alone, without keypoints (features.detect: on_demand)\n", p,
+                  by_surface_);
+    if (!mask_ious_.empty()) {
+      double sum = 0.0;
+      for (const double iou : mask_ious_) sum += iou;
+      std::printf("%spropagated mask IoU against the sequence's masks: mean %.3f, min %.3f over %zu frames\n", p,
+                  sum / double(mask_ious_.size()), *std::min_element(mask_ious_.begin(), mask_ious_.end()),
+                  mask_ious_.size());
+    }
+    if (const std::vector<bt::ModelPoint> model = tracker.objectModel(); !model.empty()) {
+      bt::io::writeModelPly(out_ / "model.ply", model);
+      std::printf("%sobject model: %s (%zu points fused from %zu keyframes)\n", p, (out_ / "model.ply").string().c_str(),
+                  model.size(), tracker.keyframeCount());
+    }
+  }
+
+  /// The object's rows of the score table: its score, with lost frames scored as failures in a
+  /// second row where there were any (a lost frame keeps the last pose, which the first row
+  /// scores as its estimate); nothing without ground truth and a model.
+  void scoreRows(const std::string& label, std::vector<bt::NamedScore>& rows) const {
+    if (!scored_ || truth_.empty()) return;
+    rows.push_back({label, bt::scoreSequence(model_, truth_, estimate_)});
+    if (lost_ > 0) rows.push_back({label + " (lost=failed)", bt::scoreSequence(model_, truth_, estimate_unless_lost_)});
+  }
+
+  /// OUT[/object]/errors.png: the errors over the frames, lost frames shaded and left out (the
+  /// pose a lost frame keeps is not one the tracker stands behind). Empty without ground truth.
+  std::optional<fs::path> plotErrors() const {
+    if (!scored_ || truth_.empty()) return std::nullopt;
+    const auto unless_lost = [&](std::vector<double> errors) {
+      for (std::size_t k = 0; k < errors.size(); ++k)
+        if (lost_scored_[k]) errors[k] = std::numeric_limits<double>::quiet_NaN();
+      return errors;
+    };
+    const cv::Mat errors = bt::viz::plotErrors({{"rotation error [deg]", unless_lost(rotation_errors_)},
+                                                {"translation error [cm]", unless_lost(translation_errors_)}},
+                                               lost_scored_);
+    const fs::path plot = out_ / "errors.png";
+    if (!cv::imwrite(plot.string(), errors)) throw bt::InputError(plot, "cannot write image");
+    return plot;
+  }
+
+ private:
+  std::string object_;
+  fs::path out_;
+  const bt::io::RgbdSequence& sequence_;
+  bool propagated_, strict_, scored_;
+  std::vector<Eigen::Vector3f> model_;
+  std::optional<bt::ObjectBox> box_;
+  std::ofstream csv_;
+  std::optional<std::size_t> first_frame_;  ///< the frame the object started in
+  int frames_ = 0, lost_ = 0, unreadable_ = 0, unscored_ = 0, by_surface_ = 0;
+  std::string first_unreadable_;
+  bt::SE3d last_pose_;  ///< what a frame the object sits out reports
+  std::vector<bt::SE3d> truth_;
+  std::vector<std::optional<bt::SE3d>> estimate_;  ///< none: the frame could not be read, a failure for the scores
+  std::vector<std::optional<bt::SE3d>> estimate_unless_lost_;  ///< none also where the tracker lost the object
+  std::vector<double> rotation_errors_, translation_errors_, mask_ious_;
+  std::vector<bool> lost_scored_;  ///< per scored frame, for the error plot
+};
+
+/// A frame's files as read ahead: colour, depth, and each object's mask where it has one.
+struct FrameData {
+  bt::RawFrame raw;
+  std::vector<std::optional<cv::Mat>> masks;
+};
+
+int run(bt::MultiObjectTracker& tracker, const bt::io::RgbdSequence& sequence, const std::vector<std::string>& objects,
+        const Options& options) {
   const bool propagated = options.config.masks == "propagated";
-  csv << "frame,status,by_surface,keypoints,matches,inliers,read_ms,mask_ms,features_ms,matching_ms,ransac_ms,graph_ms,solve_ms,total_ms"
-      << (scored ? ",rotation_error_deg,translation_error_cm" : "") << (propagated ? ",mask_iou" : "") << ",problem\n";
-  std::vector<bt::SE3d> truth;
-  std::vector<std::optional<bt::SE3d>> estimate;  // none: the frame could not be read, a failure for the scores
-  std::vector<std::optional<bt::SE3d>> estimate_unless_lost;  // none also where the tracker lost the object
-  int lost = 0, unreadable = 0, unscored = 0, by_surface = 0;
-  std::string first_unreadable;
-  bt::SE3d last_pose;  // what a frame that cannot be read reports
+  const bool several = !sequence.objects().empty();
+  std::vector<std::unique_ptr<ObjectOutput>> outputs;
+  for (const std::string& object : objects)
+    outputs.push_back(std::make_unique<ObjectOutput>(object, several ? options.out / object : options.out, sequence, options));
+  const std::size_t count = objects.size();
   const bool interactive = isatty(fileno(stderr));
   std::optional<OverlayWriter> overlay;
   if (options.viz) overlay.emplace(options.out, sequence);
-  std::vector<double> rotation_errors, translation_errors, mask_ious, total_ms, read_ms_all, features_ms;
-  std::vector<bool> lost_scored;  // per scored frame, for the error plot
-  // Files are decoded a few frames ahead on another thread; each frame is preprocessed only where
-  // the tracker will look (Tracker::regionOfInterest).
-  bt::io::ReadAhead<bt::RawFrame> files(sequence.size(), [&](std::size_t i) { return sequence.read(i); });
+  std::vector<double> tracking_ms, read_ms_all, features_ms;
+  int tracked_after_first = 0;
+  // Files are decoded a few frames ahead on another thread; each frame is preprocessed once, only
+  // where the trackers will look (MultiObjectTracker::regionOfInterest).
+  bt::io::ReadAhead<FrameData> files(sequence.size(), [&](std::size_t i) {
+    FrameData data{sequence.read(i), {}};
+    for (const std::string& object : objects)
+      data.masks.push_back(!several ? (data.raw.mask.empty() ? std::nullopt : std::optional(data.raw.mask))
+                                    : sequence.mask(i, object));
+    return data;
+  });
   bt::Stopwatch whole_run, progress;
   double elapsed_ms = 0.0, shown_ms = -1e9;  // since the start, and when the progress line was drawn
   for (std::size_t i = 0; i < sequence.size(); ++i) {
     bt::Stopwatch reading;
-    // A frame whose files cannot be read (or, with given masks, has no mask) is reported lost with
-    // the reason and keeps the last pose; the run goes on. Not so for the first frame, nor with --strict.
+    // A frame whose files cannot be read is lost with the reason for every object, which keeps its
+    // last pose; an object whose own mask is missing (given masks) sits the frame out likewise.
+    // The run goes on; not so for the first frame, nor with --strict.
     std::optional<bt::RgbdFrame> frame;
-    cv::Mat dataset_mask;
-    std::string problem;
+    std::string frame_problem;
+    std::vector<std::string> problems(count);
+    std::vector<std::optional<cv::Mat>> given(count);  // what each tracker gets; none: it sits the frame out
+    std::vector<cv::Mat> dataset_masks(count);
     try {
-      bt::RawFrame raw = files.next();
-      dataset_mask = raw.mask;
-      if (propagated && i > 0) raw.mask = cv::Mat();  // the tracker must not see it
-      if (!propagated && i > 0 && raw.mask.empty())
-        throw bt::InputError(sequence.maskPath(i), "file not found: tracking with given masks needs a mask for "
-                                                   "every frame (or use --propagate-masks)");
-      const cv::Rect region = tracker.regionOfInterest(raw.color.size(), raw.mask);
-      frame = sequence.preprocess(std::move(raw), region);
+      FrameData data = files.next();
+      for (std::size_t k = 0; k < count; ++k) {
+        dataset_masks[k] = data.masks[k].value_or(cv::Mat());
+        if (propagated) {
+          given[k] = tracker.started(k) ? cv::Mat() : dataset_masks[k];  // after its start the tracker must not see it
+        } else if (data.masks[k] || !tracker.started(k)) {
+          given[k] = dataset_masks[k];
+        } else {
+          const bt::InputError missing(sequence.maskPath(i, objects[k]),
+                                       "file not found: tracking with given masks needs a mask for every frame (or use "
+                                       "--propagate-masks)");
+          if (options.strict || (i == 0 && !several)) throw missing;
+          problems[k] = missing.what();
+        }
+      }
+      data.raw.mask = cv::Mat();
+      const cv::Rect region = tracker.regionOfInterest(data.raw.color.size(), given);
+      frame = sequence.preprocess(std::move(data.raw), region);
     } catch (const bt::InputError& error) {
       if (i == 0 || options.strict) throw;
-      problem = error.what();
+      frame_problem = error.what();
     }
     const double read_ms = reading.lap();
-    const std::string name = sequence.frameNames()[i];
-    bt::TrackResult result;
+    std::vector<std::optional<bt::TrackResult>> results(count);
+    bt::Stopwatch tracking;
     if (frame) {
-      const bt::SE3d initial = sequence.hasGroundTruth() ? sequence.groundTruthPose(0) : bt::SE3d();
-      result = i == 0 ? tracker.initialize(*frame, initial) : tracker.track(*frame);
-    } else {
-      result.T_cam_obj = last_pose;
-      result.status = bt::TrackStatus::Lost;
-      if (unreadable++ == 0) first_unreadable = problem;
-      if (!options.quiet) std::fprintf(stderr, "%sframe %s lost: %s\n", interactive ? "\n" : "", name.c_str(), problem.c_str());
+      // An object starts at its annotated pose in that frame where it has ground truth (its first
+      // frame stays strict), else at the identity.
+      std::vector<bt::SE3d> start(count);
+      for (std::size_t k = 0; k < count; ++k)
+        if (!tracker.started(k) && given[k] && cv::countNonZero(*given[k]) > 0 && sequence.hasGroundTruth(objects[k]))
+          start[k] = sequence.groundTruthPose(i, objects[k]);
+      results = tracker.track(*frame, given, start);
     }
-    last_pose = result.T_cam_obj;
+    const double track_ms = tracking.lap();
     if (i == 0) whole_run.lap();  // the whole run's time counts from the first tracked frame
-    lost += result.status == bt::TrackStatus::Lost;
-    by_surface += result.surface_only;
-    bt::io::writePose(options.out / "poses" / (name + ".txt"), result.T_cam_obj);
-    const auto& t = result.timings;
-    if (i > 0 && frame) total_ms.push_back(t.total), read_ms_all.push_back(read_ms), features_ms.push_back(t.features);
-    csv << name << ',' << bt::statusName(result.status) << ',' << result.surface_only << ',' << result.keypoints << ',' << result.matches << ','
-        << result.inliers << ',' << read_ms << ',' << t.mask << ',' << t.features << ',' << t.matching << ',' << t.ransac << ',' << t.graph
-        << ',' << t.solve << ',' << t.total;
-    if (scored) {
-      // A frame without an annotated pose is not scored; one that could not be read scores as a failure.
-      std::optional<bt::SE3d> true_pose;
-      try {
-        true_pose = sequence.groundTruthPose(i);
-      } catch (const bt::InputError& error) {
-        if (i == 0 || options.strict) throw;
-        ++unscored;
-        if (problem.empty()) problem = std::string(error.what()) + " (frame not scored)";
+    std::vector<bt::TrackResult> drawn(count);
+    std::vector<DrawnObject> drawn_objects;
+    int lost = 0, tracked = 0;
+    double features = 0.0;
+    for (std::size_t k = 0; k < count; ++k) {
+      const std::string& problem = frame ? problems[k] : frame_problem;
+      const bool started = tracker.started(k);
+      if (started && !results[k] && !options.quiet)
+        std::fprintf(stderr, "%sframe %s%s lost: %s\n", interactive ? "\n" : "", sequence.frameNames()[i].c_str(),
+                     several ? (" " + objects[k]).c_str() : "", problem.c_str());
+      const std::optional<bt::TrackResult> recorded =
+          outputs[k]->record(i, std::move(results[k]), started, problem, read_ms, dataset_masks[k]);
+      if (recorded) {
+        drawn[k] = *recorded;
+        features += recorded->timings.features;
+        tracked += recorded->status != bt::TrackStatus::Lost;
       }
-      csv << ',';
-      if (true_pose) {
-        truth.push_back(*true_pose);
-        estimate.push_back(frame ? std::optional(result.T_cam_obj) : std::nullopt);
-        estimate_unless_lost.push_back(result.status != bt::TrackStatus::Lost ? std::optional(result.T_cam_obj)
-                                                                              : std::nullopt);
-        rotation_errors.push_back(bt::rotationErrorDeg(*true_pose, result.T_cam_obj));
-        translation_errors.push_back(100.0 * bt::translationError(*true_pose, result.T_cam_obj));
-        lost_scored.push_back(result.status == bt::TrackStatus::Lost);
-        csv << rotation_errors.back() << ',' << translation_errors.back();
-      } else {
-        csv << ',';
-      }
+      lost += outputs[k]->lost();
+      drawn_objects.push_back({several ? objects[k] : "", recorded ? &drawn[k] : nullptr, &outputs[k]->box()});
     }
-    if (propagated) {
-      // A frame lost before a mask was made counts as an empty mask.
-      const cv::Mat used = result.mask.empty() ? cv::Mat::zeros(sequence.imageSize(), CV_8UC1) : result.mask;
-      const fs::path mask_path = options.out / "masks" / (name + ".png");
-      if (!cv::imwrite(mask_path.string(), used)) throw bt::InputError(mask_path, "cannot write image");
-      if (!dataset_mask.empty()) mask_ious.push_back(bt::maskIoU(used > 0, dataset_mask > 0));
-      csv << ',';
-      if (!dataset_mask.empty()) csv << mask_ious.back();
-    }
-    if (frame && overlay) {
-      frame->mask = result.mask;  // the overlay outlines the mask the tracker used
-      overlay->add(i, *frame, result);
-    }
-    csv << ',' << csvField(problem) << '\n';
+    if (i > 0 && frame) tracking_ms.push_back(track_ms), read_ms_all.push_back(read_ms), features_ms.push_back(features);
+    if (i > 0) tracked_after_first += tracked;
+    if (frame && overlay) overlay->add(i, *frame, drawn_objects);
     // Progress: on a terminal one line redrawn ten times a second, in a log a line every 50 frames;
     // the rate and the time left from the frames so far.
     elapsed_ms += progress.lap();
@@ -289,71 +506,47 @@ int run(bt::AnyTracker& tracker, const bt::io::RgbdSequence& sequence, const Opt
     if (!options.quiet && (interactive ? elapsed_ms - shown_ms >= 100.0 || last : (i + 1) % 50 == 0 || last)) {
       shown_ms = elapsed_ms;
       const double per_frame_ms = elapsed_ms / double(i + 1);
-      std::fprintf(stderr, "%sframe %zu/%zu  %-7s  inliers %3d/%-3d  %5.1f ms  |  %.1f fps, %d lost, %.0f s left%s",
-                   interactive ? "\r" : "", i + 1, sequence.size(), std::string(bt::statusName(result.status)).c_str(),
-                   result.inliers, result.matches, t.total, 1000.0 / per_frame_ms, lost,
+      char state[64];
+      if (several) std::snprintf(state, sizeof(state), "%d/%zu objects tracked", tracked, count);
+      else std::snprintf(state, sizeof(state), "%-7s  inliers %3d/%-3d", std::string(bt::statusName(drawn[0].status)).c_str(),
+                         drawn[0].inliers, drawn[0].matches);
+      std::fprintf(stderr, "%sframe %zu/%zu  %s  %5.1f ms  |  %.1f fps, %d lost, %.0f s left%s", interactive ? "\r" : "", i + 1,
+                   sequence.size(), state, track_ms, 1000.0 / per_frame_ms, lost,
                    per_frame_ms * double(sequence.size() - i - 1) / 1000.0, interactive ? "   " : "\n");
     }
   }
   const double run_ms = whole_run.lap();  // frames 1 .. n-1 with writing the results
   if (!options.quiet && interactive) std::fprintf(stderr, "\n");
-  std::printf("%s: %zu frames, %d lost; poses in %s\n", options.sequence.string().c_str(), sequence.size(), lost,
-              (options.out / "poses").string().c_str());
-  if (unreadable > 0)
-    std::printf("%d of the lost frames could not be read (first: %s); the reasons are in track.csv's problem column\n",
-                unreadable, first_unreadable.c_str());
-  if (unscored > 0) std::printf("%d frames without an annotated pose were not scored\n", unscored);
-  if (by_surface > 0)
-    std::printf("%d frames tracked by the dense term alone, without keypoints (features.detect: on_demand)\n", by_surface);
+  const std::string sequence_name = options.sequence.string();
+  for (std::size_t k = 0; k < count; ++k)
+    outputs[k]->report(several ? "[" + objects[k] + "]" : sequence_name + ":", several ? "[" + objects[k] + "] " : "",
+                       tracker.tracker(k));
   // Rates only where something was tracked: the time of frames that were all lost is no frame rate.
-  if (sequence.size() > 1 && lost == int(sequence.size()) - 1) {
+  if (sequence.size() > 1 && tracked_after_first == 0) {
     std::printf("no frame after the first was tracked: no frame rate\n");
-  } else if (!total_ms.empty()) {
-    const double tracking = median(total_ms);
-    std::printf("median per frame: %.1f ms tracking (%.1f fps; keypoint detection %.1f ms of it), %.1f ms waiting "
+  } else if (!tracking_ms.empty()) {
+    const double median_ms = median(tracking_ms);
+    std::printf("median per frame: %.1f ms tracking%s (%.1f fps; keypoint detection %.1f ms of it), %.1f ms waiting "
                 "for its files and preprocessing it; per stage in track.csv\n",
-                tracking, 1000.0 / tracking, median(features_ms), median(read_ms_all));
+                median_ms, several ? (" " + std::to_string(count) + " objects").c_str() : "", 1000.0 / median_ms,
+                median(features_ms), median(read_ms_all));
     const double per_frame = run_ms / double(sequence.size() - 1);
     std::printf("whole run after the first frame: %.1f ms per frame from the files to the poses written (%.1f fps)\n",
                 per_frame, 1000.0 / per_frame);
   }
-  if (!mask_ious.empty()) {
-    double sum = 0.0;
-    for (const double iou : mask_ious) sum += iou;
-    std::printf("propagated mask IoU against the sequence's masks: mean %.3f, min %.3f over %zu frames\n",
-                sum / double(mask_ious.size()), *std::min_element(mask_ious.begin(), mask_ious.end()), mask_ious.size());
-  }
-  if (const std::vector<bt::ModelPoint> object = tracker.objectModel(); !object.empty()) {
-    bt::io::writeModelPly(options.out / "model.ply", object);
-    std::printf("object model: %s (%zu points fused from %zu keyframes)\n", (options.out / "model.ply").string().c_str(),
-                object.size(), tracker.keyframeCount());
-  }
-  if (scored) {
-    // A lost frame keeps the last good pose, which the first row scores as its estimate; where
-    // frames were lost, a second row scores them as failures.
-    const std::string name = options.sequence.filename().string();
-    const bt::SequenceScore score = bt::scoreSequence(model, truth, estimate);
-    std::vector<bt::NamedScore> rows = {{name, score}};
-    if (lost > 0) rows.push_back({name + " (lost=failed)", bt::scoreSequence(model, truth, estimate_unless_lost)});
-    std::printf("%s", bt::formatScoreTable(rows, bt::MeanRow::Omit).c_str());  // two views of one run: no mean
-    std::printf("final-frame ADD %.2f cm\n", score.final_add_cm);
+  std::vector<bt::NamedScore> rows;
+  for (std::size_t k = 0; k < count; ++k)
+    outputs[k]->scoreRows(several ? objects[k] : options.sequence.filename().string(), rows);
+  if (!rows.empty()) {
+    std::printf("%s", bt::formatScoreTable(rows, bt::MeanRow::Omit).c_str());  // views of one run, objects apart: no mean
+    for (const bt::NamedScore& row : rows)
+      if (row.sequence.find(" (lost=failed)") == std::string::npos)
+        std::printf("final-frame ADD%s %.2f cm\n", several ? (" " + row.sequence).c_str() : "", row.score.final_add_cm);
   }
   if (overlay) {
     std::printf("overlay: %s\n", overlay->finish().c_str());
-    if (scored) {
-      const fs::path plot = options.out / "errors.png";
-      // A lost frame keeps the last pose, which the tracker does not stand behind: a gap, shaded.
-      const auto unless_lost = [&](std::vector<double> errors) {
-        for (std::size_t k = 0; k < errors.size(); ++k)
-          if (lost_scored[k]) errors[k] = std::numeric_limits<double>::quiet_NaN();
-        return errors;
-      };
-      const cv::Mat errors = bt::viz::plotErrors({{"rotation error [deg]", unless_lost(rotation_errors)},
-                                                  {"translation error [cm]", unless_lost(translation_errors)}},
-                                                 lost_scored);
-      if (!cv::imwrite(plot.string(), errors)) throw bt::InputError(plot, "cannot write image");
-      std::printf("error plot: %s\n", plot.string().c_str());
-    }
+    for (std::size_t k = 0; k < count; ++k)
+      if (const auto plot = outputs[k]->plotErrors()) std::printf("error plot: %s\n", plot->string().c_str());
   }
   return 0;
 }
@@ -383,6 +576,7 @@ int main(int argc, char** argv) {
              arg == "--sensor")
       overrides.emplace_back(arg, value());
     else if (arg == "--propagate-masks" || arg == "--gpu") overrides.emplace_back(arg, "");
+    else if (arg == "--objects") options.objects = value();
     else if (arg == "--quiet") options.quiet = true;
     else if (arg == "--strict") options.strict = true;
     else if (arg == "--viz") options.viz = true;
@@ -411,10 +605,15 @@ int main(int argc, char** argv) {
       return 0;
     }
     if (options.sequence.empty() || options.out.empty()) fail("--sequence and --out are required");
-    prepareOutput(options.out, config.masks == "propagated");
+    prepareOutput(options.out, {});
     const bt::io::RgbdSequence sequence(options.sequence, config.sequence);
-    const std::unique_ptr<bt::AnyTracker> tracker = bt::makeTracker(config, sequence.camera().cast<float>());
-    return run(*tracker, sequence, options);
+    const std::vector<std::string> objects = chosenObjects(sequence, options.objects);
+    std::vector<fs::path> folders = {"poses"};
+    if (config.masks == "propagated") folders.push_back("masks");
+    for (const std::string& object : objects) prepareOutput(options.out / object, folders);
+    const bt::PinholeCameraf camera = sequence.camera().cast<float>();
+    bt::MultiObjectTracker tracker(objects.size(), [&] { return bt::makeTracker(config, camera); });
+    return run(tracker, sequence, objects, options);
   } catch (const std::invalid_argument& error) {
     fail(error.what());
   } catch (const std::exception& error) {

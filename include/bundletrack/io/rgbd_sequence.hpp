@@ -1,5 +1,6 @@
 #pragma once
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <optional>
@@ -31,7 +32,9 @@ struct SequenceSettings {
 ///   masks/<name>.png     object mask     (the first frame's is required, later ones optional)
 ///   cam_K.txt            3x3 intrinsics  annotated_poses/<name>.txt  4x4 T_cam_obj (optional)
 ///   model/points.xyz     object points in the object frame (optional)
-/// where <name> is a frame's colour image's file stem.
+/// where <name> is a frame's colour image's file stem. Several objects: masks/ holds a folder per
+/// object instead (masks/<object>/<name>.png; an object starts at its first non-empty mask, and
+/// the first frame needs none), and so do annotated_poses/<object>/ and model/<object>/.
 class RgbdSequence {
  public:
   explicit RgbdSequence(std::filesystem::path root, SequenceSettings settings = {})
@@ -52,11 +55,25 @@ class RgbdSequence {
                                                 std::to_string(image_size_.width) + "x" +
                                                 std::to_string(image_size_.height) + " image");
     checkFieldOfView(camera_, image_size_, root_ / "cam_K.txt");
+    objects_ = objectFolders();
+    if (!objects_.empty()) {
+      // The depth unit is judged under the objects visible in the first frame, else over the whole frame.
+      cv::Mat visible = cv::Mat::zeros(image_size_, CV_8UC1);
+      for (const std::string& object : objects_)
+        if (const auto m = mask(0, object)) visible |= *m;
+      if (cv::countNonZero(visible) == 0) visible.setTo(255);
+      checkDepthScale(rawDepth(0), visible, depth_scale_, depthPath(0));
+      return;
+    }
     const auto first_mask = mask(0);
     if (!first_mask) throw InputError(maskPath(0), "the first frame needs an object mask: file not found");
     if (cv::countNonZero(*first_mask) == 0) throw InputError(maskPath(0), "the first frame's object mask is empty");
     checkDepthScale(rawDepth(0), *first_mask, depth_scale_, depthPath(0));
   }
+
+  /// The objects of a sequence with a folder of masks per object, in name order; empty for a
+  /// sequence of one object (masks/<name>.png), whose functions below take the object "".
+  const std::vector<std::string>& objects() const { return objects_; }
 
   std::size_t size() const { return frames_.names.size(); }
   const std::vector<std::string>& frameNames() const { return frames_.names; }
@@ -93,9 +110,9 @@ class RgbdSequence {
     return depth;
   }
 
-  /// The mask of frame i, or nothing when masks/<name>.png does not exist.
-  std::optional<cv::Mat> mask(std::size_t i) const {
-    const auto path = maskPath(i);
+  /// The mask of frame i (of `object`), or nothing when its file does not exist.
+  std::optional<cv::Mat> mask(std::size_t i, const std::string& object = {}) const {
+    const auto path = maskPath(i, object);
     if (!std::filesystem::exists(path)) return std::nullopt;
     cv::Mat m = readMask(path);
     requireSize(m, path);
@@ -105,13 +122,17 @@ class RgbdSequence {
   /// Frame i's files (the mask's may not exist).
   std::filesystem::path colorPath(std::size_t i) const { return frames_.color.at(i); }
   std::filesystem::path depthPath(std::size_t i) const { return frames_.depth.at(i); }  ///< empty: none
-  std::filesystem::path maskPath(std::size_t i) const { return root_ / "masks" / (frames_.names.at(i) + ".png"); }
+  std::filesystem::path maskPath(std::size_t i, const std::string& object = {}) const {
+    return folder("masks", object) / (frames_.names.at(i) + ".png");
+  }
 
-  bool hasGroundTruth() const { return std::filesystem::is_directory(root_ / "annotated_poses"); }
-  SE3d groundTruthPose(std::size_t i) const { return readPose(root_ / "annotated_poses" / (frames_.names.at(i) + ".txt")); }
+  bool hasGroundTruth(const std::string& object = {}) const { return std::filesystem::is_directory(folder("annotated_poses", object)); }
+  SE3d groundTruthPose(std::size_t i, const std::string& object = {}) const {
+    return readPose(folder("annotated_poses", object) / (frames_.names.at(i) + ".txt"));
+  }
 
-  bool hasModel() const { return std::filesystem::is_regular_file(modelPath()); }
-  std::vector<Eigen::Vector3f> modelPoints() const { return readPoints(modelPath()); }
+  bool hasModel(const std::string& object = {}) const { return std::filesystem::is_regular_file(modelPath(object)); }
+  std::vector<Eigen::Vector3f> modelPoints(const std::string& object = {}) const { return readPoints(modelPath(object)); }
 
  private:
   void requireSize(const cv::Mat& image, const std::filesystem::path& path) const {
@@ -121,11 +142,27 @@ class RgbdSequence {
                                  std::to_string(image_size_.height));
   }
 
-  std::filesystem::path modelPath() const { return root_ / "model" / "points.xyz"; }
+  /// root/<kind>, or its subfolder of `object`.
+  std::filesystem::path folder(const char* kind, const std::string& object) const {
+    return object.empty() ? root_ / kind : root_ / kind / object;
+  }
+  std::filesystem::path modelPath(const std::string& object) const { return folder("model", object) / "points.xyz"; }
+
+  /// The folders of masks/ when the first frame has no mask of its own (masks/<name>.png).
+  std::vector<std::string> objectFolders() const {
+    std::vector<std::string> names;
+    std::error_code error;
+    if (std::filesystem::exists(maskPath(0)) || !std::filesystem::is_directory(root_ / "masks", error)) return names;
+    for (const auto& entry : std::filesystem::directory_iterator(root_ / "masks"))
+      if (entry.is_directory()) names.push_back(entry.path().filename().string());
+    std::sort(names.begin(), names.end());
+    return names;
+  }
 
   std::filesystem::path root_;
   SequenceSettings settings_;
   FrameFiles frames_;
+  std::vector<std::string> objects_;
   double depth_scale_ = 0.001;
   PinholeCamerad camera_;
   cv::Size image_size_;

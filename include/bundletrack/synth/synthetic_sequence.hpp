@@ -7,6 +7,7 @@
 #include <mutex>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include <Eigen/Geometry>
 #include <opencv2/core.hpp>
@@ -24,6 +25,15 @@ namespace bundletrack::synth {
 
 enum class Shape { Box, Cylinder, Mug, Chair };
 enum class Motion { HandHeld, CameraOrbit };
+
+inline const char* shapeName(Shape shape) {
+  switch (shape) {
+    case Shape::Cylinder: return "cylinder";
+    case Shape::Mug: return "mug";
+    case Shape::Chair: return "chair";
+    default: return "box";
+  }
+}
 
 struct SyntheticSequenceSettings {
   int frames = 300;
@@ -44,23 +54,36 @@ struct SyntheticSequenceSettings {
   int hidden_start = -1;  ///< from this frame the hand carries the object out of view (-1: never) ...
   int hidden_frames = 0;  ///< ... for this many frames; it comes back where its motion has taken it
   int motion_blur_samples = 1;  ///< > 1: colour averaged over this many instants of a half-frame exposure
+  /// 1-3 objects. The others are the first of box, cylinder, mug that the first object is not,
+  /// each with its own texture and hand-held motion: the second sweeps sideways in front of the
+  /// first object, the third behind it, so that they occlude each other. (Hand-held motion only.)
+  int objects = 1;
   SensorSettings sensor;
   unsigned seed = 1;
   int model_points = 4000;  ///< surface samples written to model/points.xyz
+};
+
+/// Where one object of a frame is: its visible pixels and its exact pose.
+struct ObjectView {
+  cv::Mat mask;  ///< CV_8UC1 255 where the object is the visible surface
+  SE3d T_cam_obj;
 };
 
 /// One rendered frame with its exact ground truth.
 struct SyntheticFrame {
   cv::Mat color;  ///< CV_8UC3 BGR, with sensor noise
   cv::Mat depth;  ///< CV_32FC1 metres, with the sensor model applied; 0 = no reading
-  cv::Mat mask;  ///< CV_8UC1 255 where the object is the visible surface
-  SE3d T_cam_obj;
+  cv::Mat mask;  ///< CV_8UC1 255 where the (first) object is the visible surface
+  SE3d T_cam_obj;  ///< of the (first) object
+  std::vector<ObjectView> others;  ///< the other objects (SyntheticSequenceSettings::objects)
 };
 
-/// The scene of a synthetic sequence: object, table, wall, optional occluder and their motion.
+/// The scene of a synthetic sequence: object(s), table, wall, optional occluder and their motion.
 class SyntheticScene {
  public:
   static constexpr int kTable = 0, kWall = 1, kObject = 2, kOccluder = 3;
+  /// Render label of object k (0: the first object, kObject).
+  static constexpr int objectLabel(int k) { return k == 0 ? kObject : kOccluder + k; }
 
   explicit SyntheticScene(SyntheticSequenceSettings settings)
       : s_(std::move(settings)),
@@ -78,12 +101,36 @@ class SyntheticScene {
     if (!(s_.size >= 0.0) || s_.size > 5.0)
       throw InputError("synthetic sequence", "size must be 0 (the shape's own) or up to 5 m");
     if (s_.motion_blur_samples < 1) throw InputError("synthetic sequence", "motion_blur_samples must be >= 1");
+    if (s_.objects < 1 || s_.objects > 3) throw InputError("synthetic sequence", "objects must be 1, 2 or 3");
+    if (s_.objects > 1 && s_.motion != Motion::HandHeld)
+      throw InputError("synthetic sequence", "several objects move only by hand (hand-held motion)");
+    for (const Shape shape : {Shape::Box, Shape::Cylinder, Shape::Mug}) {
+      if (int(others_.size()) + 1 == s_.objects) break;
+      if (shape == s_.shape) continue;
+      const unsigned seed = s_.seed + 101u * unsigned(others_.size() + 1);
+      others_.push_back({shape, makeObjectMesh(shape, 0.0), s_.textureless ? plainTexture({200, 120, 70}) : richTexture(512, seed)});
+    }
   }
 
   const SyntheticSequenceSettings& settings() const { return s_; }
-  const TriangleMesh& objectMesh() const { return object_mesh_; }
+  int objectCount() const { return 1 + int(others_.size()); }
+  const TriangleMesh& objectMesh(int k = 0) const { return k == 0 ? object_mesh_ : others_.at(std::size_t(k - 1)).mesh; }
+  Shape objectShape(int k = 0) const { return k == 0 ? s_.shape : others_.at(std::size_t(k - 1)).shape; }
+  /// The folder name of object k's masks, poses and model in a sequence of several objects.
+  std::string objectName(int k) const { return shapeName(objectShape(k)); }
 
-  SE3d T_world_obj(double frame) const {
+  /// Object k's pose in the world. The other objects (k > 0) are carried by their own hands: the
+  /// hand-held motion shifted in phase, about a centre that sweeps 15 cm to either side 12 cm in
+  /// front of the first object's (k = 1) or 12 cm behind it (k = 2), on the camera's line of
+  /// sight, so that they pass in front of each other.
+  SE3d T_world_obj(double frame, int k = 0) const {
+    if (k > 0) {
+      HandHeldMotion hand;
+      const double phase = motionPhase(frame, s_.speed), nearer = k == 1 ? 0.12 : -0.12;
+      const Eigen::Vector3d towards_camera = (hand.eye - hand.centre).normalized();
+      hand.centre += nearer * towards_camera + Eigen::Vector3d(0.15 * std::cos(1.3 * phase + 0.4 * k), 0.0, 0.0);
+      return hand.T_world_obj(frame + 70.0 * k, s_.speed);
+    }
     if (s_.motion == Motion::HandHeld) {
       SE3d T = HandHeldMotion().T_world_obj(frame, s_.speed);
       if (frame >= s_.hidden_start && frame < s_.hidden_start + s_.hidden_frames)
@@ -106,7 +153,7 @@ class SyntheticScene {
     return SE3d(T.rotation(), target + scale * (T.translation() - target));
   }
 
-  SE3d T_cam_obj(double frame) const { return T_world_cam(frame).inverse() * T_world_obj(frame); }
+  SE3d T_cam_obj(double frame, int k = 0) const { return T_world_cam(frame).inverse() * T_world_obj(frame, k); }
 
   /// Noise-free render at a (possibly fractional) frame time.
   RenderBuffers renderClean(double frame, bool with_object = true) const {
@@ -121,6 +168,10 @@ class SyntheticScene {
         plane({-1.0, 1.0, 1.2}, Eigen::Vector3d::UnitX(), -Eigen::Vector3d::UnitZ(), 2.0, wall_texture_, kWall)};
     std::vector<MeshInstance> meshes;
     if (with_object) meshes.push_back({&object_mesh_, &object_texture_, T_cam_obj(frame), kObject});
+    for (int k = 1; k < objectCount(); ++k) {
+      const OtherObject& other = others_[std::size_t(k - 1)];
+      meshes.push_back({&other.mesh, &other.texture, T_cam_obj(frame, k), objectLabel(k)});
+    }
     if (const auto T_cam_occluder = occluderPose(frame)) {
       meshes.push_back({&occluder_mesh_, &occluder_texture_, T_cam_world * *T_cam_occluder, kOccluder});
     }
@@ -139,6 +190,7 @@ class SyntheticScene {
     applySensorModel(clean, s_.camera, s_.sensor, s_.seed * 100003u + unsigned(i), out.depth, out.color);
     out.mask = clean.label == kObject;
     out.T_cam_obj = T_cam_obj(i);
+    for (int k = 1; k < objectCount(); ++k) out.others.push_back({clean.label == objectLabel(k), T_cam_obj(i, k)});
     return out;
   }
 
@@ -181,10 +233,17 @@ class SyntheticScene {
     return SE3d(SO3d(), middle + (progress - 0.5) * 0.5 * sideways);
   }
 
+  struct OtherObject {
+    Shape shape;
+    TriangleMesh mesh;
+    cv::Mat texture;
+  };
+
   SyntheticSequenceSettings s_;
   Renderer renderer_;
   TriangleMesh object_mesh_, occluder_mesh_;
   cv::Mat object_texture_, table_texture_, wall_texture_, occluder_texture_;
+  std::vector<OtherObject> others_;
 };
 
 namespace detail {
@@ -206,6 +265,12 @@ inline std::string tumName(double time) {
   return buffer;
 }
 
+/// Where object k's masks, poses and model go: masks/, annotated_poses/, model/ themselves for a
+/// single object, their subfolder <object name> when the scene has several.
+inline std::filesystem::path objectFolder(const std::filesystem::path& folder, const SyntheticScene& scene, int k) {
+  return scene.objectCount() == 1 ? folder : folder / scene.objectName(k);
+}
+
 /// Writes frame i of `scene` under root: named %06d with depth in millimetres (YCBInEOAT), or by
 /// its timestamps with depth in 1/5000 m (TUM).
 inline void writeFrame(const std::filesystem::path& root, const SyntheticScene& scene, int i, io::Layout layout) {
@@ -218,19 +283,25 @@ inline void writeFrame(const std::filesystem::path& root, const SyntheticScene& 
   frame.depth.convertTo(depth_units, CV_16UC1, tum ? 5000.0 : 1000.0);  // rounds to the nearest unit
   detail::writeImage(root / "rgb" / (name + ".png"), frame.color);
   detail::writeImage(root / "depth" / ((tum ? tumName(tumDepthTime(i)) : name) + ".png"), depth_units);
-  detail::writeImage(root / "masks" / (name + ".png"), frame.mask);
-  io::writePose(root / "annotated_poses" / (name + ".txt"), frame.T_cam_obj);
+  for (int k = 0; k < scene.objectCount(); ++k) {
+    const ObjectView view = k == 0 ? ObjectView{frame.mask, frame.T_cam_obj} : frame.others[std::size_t(k - 1)];
+    detail::writeImage(objectFolder(root / "masks", scene, k) / (name + ".png"), view.mask);
+    io::writePose(objectFolder(root / "annotated_poses", scene, k) / (name + ".txt"), view.T_cam_obj);
+  }
 }
 
 /// Writes the sequence in the YCBInEOAT layout (rgb/, depth/ uint16 mm, masks/, annotated_poses/,
 /// cam_K.txt, model/points.xyz), or in the TUM RGB-D layout (the same with rgb.txt and depth.txt
-/// listing timestamped images, depth in 1/5000 m). Frames are rendered in parallel; the result
-/// depends only on the settings.
+/// listing timestamped images, depth in 1/5000 m); a scene of several objects has a subfolder per
+/// object in masks/, annotated_poses/ and model/ (objectFolder). Frames are rendered in parallel;
+/// the result depends only on the settings.
 inline void writeSyntheticSequence(const std::filesystem::path& root, const SyntheticSequenceSettings& settings,
                                    io::Layout layout = io::Layout::YcbInEoat) {
   const SyntheticScene scene(settings);
-  for (const char* dir : {"rgb", "depth", "masks", "annotated_poses", "model"})
-    std::filesystem::create_directories(root / dir);
+  for (const char* dir : {"rgb", "depth"}) std::filesystem::create_directories(root / dir);
+  for (int k = 0; k < scene.objectCount(); ++k)
+    for (const char* dir : {"masks", "annotated_poses", "model"})
+      std::filesystem::create_directories(objectFolder(root / dir, scene, k));
   if (layout == io::Layout::Tum) {
     std::ofstream rgb(root / "rgb.txt"), depth(root / "depth.txt");
     rgb << "# color images\n# timestamp filename\n";
@@ -248,7 +319,9 @@ inline void writeSyntheticSequence(const std::filesystem::path& root, const Synt
       << "\n0 0 1\n";
     if (!K) throw InputError(root / "cam_K.txt", "cannot write file");
   }
-  io::writePoints(root / "model" / "points.xyz", scene.objectMesh().sampleSurface(settings.model_points, settings.seed));
+  for (int k = 0; k < scene.objectCount(); ++k)
+    io::writePoints(objectFolder(root / "model", scene, k) / "points.xyz",
+                    scene.objectMesh(k).sampleSurface(settings.model_points, settings.seed));
   std::mutex error_mutex;
   std::exception_ptr first_error;
   cv::parallel_for_(cv::Range(0, settings.frames), [&](const cv::Range& range) {
