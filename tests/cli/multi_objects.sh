@@ -1,0 +1,37 @@
+#!/usr/bin/env bash
+# bundletrack_track on a sequence of two objects (a folder of masks per object): each object's
+# outputs in OUT/<object>/, a score row per object, --objects choosing one of them (whose poses
+# are those of the run with both), unknown names and --objects on a one-object sequence refused
+# with the reason; a missing mask of one object loses only that object's frame.
+# Usage: multi_objects.sh BUNDLETRACK_SYNTH BUNDLETRACK_TRACK WORK_DIR
+set -euo pipefail
+synth=$1 track=$2 work=$3
+fail() { echo "FAILED: $*" >&2; exit 1; }
+rm -rf "$work" && mkdir -p "$work"
+"$synth" --out "$work/two" --objects 2 --frames 8 > /dev/null
+rm "$work/two/masks/cylinder/000004.png"
+"$track" --sequence "$work/two" --out "$work/both" --quiet > "$work/both.txt" 2> "$work/both_err.txt" \
+  || fail "exit status $?: $(cat "$work/both_err.txt")"
+for object in box cylinder; do
+  [ "$(ls "$work/both/$object/poses" | wc -l)" -eq 8 ] || fail "$object: not one pose per frame"
+  [ -s "$work/both/$object/track.csv" ] || fail "$object: no track.csv"
+  grep -Eq "^$object +[0-9.]+ +[0-9.]+ " "$work/both.txt" || fail "no score row of $object: $(cat "$work/both.txt")"
+done
+grep -q "^\[box\] 8 frames, 0 lost" "$work/both.txt" || fail "box: $(grep '^\[box\]' "$work/both.txt")"
+grep -q "^\[cylinder\] 8 frames, 1 lost" "$work/both.txt" || fail "cylinder: $(grep '^\[cylinder\]' "$work/both.txt")"
+grep "^000004," "$work/both/cylinder/track.csv" | grep -q ",lost,.*masks/cylinder/000004.png: file not found" \
+  || fail "cylinder frame 4: $(grep '^000004,' "$work/both/cylinder/track.csv")"
+"$track" --sequence "$work/two" --out "$work/box" --objects box --quiet > /dev/null
+diff -r "$work/box/box/poses" "$work/both/box/poses" > /dev/null || fail "box alone differs from box with the cylinder"
+[ ! -e "$work/box/cylinder" ] || fail "--objects box wrote the cylinder's outputs"
+
+if "$track" --sequence "$work/two" --out "$work/x" --objects box,plate 2> "$work/unknown.txt" > /dev/null; then
+  fail "--objects with an unknown name was accepted"
+fi
+grep -q "no object 'plate' in .*masks (it has box, cylinder)" "$work/unknown.txt" || fail "unknown: $(head -1 "$work/unknown.txt")"
+"$synth" --out "$work/one" --frames 2 > /dev/null
+if "$track" --sequence "$work/one" --out "$work/y" --objects box 2> "$work/single.txt" > /dev/null; then
+  fail "--objects on a one-object sequence was accepted"
+fi
+grep -q "holds the masks of one object" "$work/single.txt" || fail "single: $(head -1 "$work/single.txt")"
+echo "multi-object command line: ok"
