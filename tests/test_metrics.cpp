@@ -56,6 +56,44 @@ TEST_CASE("k-d tree nearest neighbour equals brute force, near the cloud and far
   }
 }
 
+TEST_CASE("a large model is scored on a strided subsample whose ADD-S stays within the stated bound") {
+  std::mt19937 rng(8);
+  std::uniform_real_distribution<float> u(-0.1f, 0.1f);
+  std::vector<Eigen::Vector3f> model(3000);
+  for (auto& p : model) p = Eigen::Vector3f(u(rng), u(rng), 0.5f * u(rng));
+  const bt::ScoringSubsample subsample = bt::scoringSubsample(model, 500);
+  CHECK(subsample.stride == 6);
+  REQUIRE(subsample.points.size() == 500);
+  CHECK(subsample.points[7] == model[42]);
+  // The bound: the farthest any model point lies from the subsample, by brute force.
+  double farthest = 0.0;
+  for (const auto& p : model) {
+    float nearest = std::numeric_limits<float>::max();
+    for (const auto& q : subsample.points) nearest = std::min(nearest, (p - q).squaredNorm());
+    farthest = std::max(farthest, std::sqrt(double(nearest)));
+  }
+  CHECK(subsample.bound == doctest::Approx(farthest).epsilon(1e-6));
+  // Per point the subsample's ADD-S distance lies in [whole model's, whole model's + bound], so does the mean.
+  const bt::SE3d truth(bt::SO3d::exp(Eigen::Vector3d(0.3, 0.1, -0.2)), Eigen::Vector3d(0.0, 0.0, 0.9));
+  const bt::SE3d estimate(truth.rotation() * bt::SO3d::exp(Eigen::Vector3d(0.0, 0.1, 0.0)),
+                          truth.translation() + Eigen::Vector3d(0.01, 0.0, 0.0));
+  const double whole = bt::averageDistanceSymmetric(subsample.points, bt::KdTree3(model), truth, estimate);
+  const double sub = bt::averageDistanceSymmetric(subsample.points, bt::KdTree3(subsample.points), truth, estimate);
+  CHECK(sub >= whole);
+  CHECK(sub <= whole + subsample.bound);
+  // A model within the limit is scored whole.
+  CHECK(bt::scoringSubsample(model, 3000).points.size() == 3000);
+  CHECK(bt::scoringSubsample(model, 3000).bound == 0.0);
+  // scoreSequence says what it scored on.
+  std::vector<Eigen::Vector3f> large(bt::kMostScoredPoints * 2, Eigen::Vector3f::Zero());
+  for (std::size_t i = 0; i < large.size(); ++i) large[i] = Eigen::Vector3f(u(rng), u(rng), u(rng));
+  const bt::SequenceScore score = bt::scoreSequence(large, {truth}, std::vector<bt::SE3d>{estimate});
+  CHECK(score.model_points == large.size());
+  CHECK(score.scored_points == bt::kMostScoredPoints);
+  CHECK(score.subsample_bound_cm > 0.0);
+  CHECK(bt::formatScoreTable({{"s", score}}).find("on 20000 of the model's 40000 points") != std::string::npos);
+}
+
 TEST_CASE("oriented box IoU on hand-computed configurations") {
   const bt::ObjectBox cube{Eigen::Vector3d(-0.05, -0.05, -0.05), Eigen::Vector3d(0.05, 0.05, 0.05)};
   const bt::SE3d A(bt::SO3d::exp(Eigen::Vector3d(0.3, -0.2, 0.1)), Eigen::Vector3d(0.1, 0.0, 0.7));

@@ -1,83 +1,51 @@
 #pragma once
 
-#include <algorithm>
+#include <cstdint>
 #include <limits>
-#include <numeric>
+#include <memory>
 #include <vector>
 
 #include <Eigen/Core>
+#include <nanoflann.hpp>
 
 namespace bundletrack {
 
-/// Exact nearest-neighbour queries on a fixed 3-D point set: a k-d tree over an index array,
-/// median split on the widest axis, leaves of up to 8 points. A subtree is searched only when its
-/// points' bounding box is nearer than the best point found so far; pruning by the distance to
-/// the splitting plane alone visited nearly every node for queries far from the cloud (a wrong
-/// pose when scoring ADD-S).
+/// Exact nearest-neighbour queries on a fixed 3-D point set (ADD-S), by nanoflann's k-d tree
+/// (libnanoflann-dev): leaves of up to 10 points, subtrees pruned by their distance to the query,
+/// so queries far from the cloud (a wrong pose scored) stay cheap.
 class KdTree3 {
  public:
-  explicit KdTree3(std::vector<Eigen::Vector3f> points) : points_(std::move(points)), order_(points_.size()) {
-    std::iota(order_.begin(), order_.end(), 0);
-    if (!points_.empty()) build(0, int(order_.size()));
-  }
+  explicit KdTree3(std::vector<Eigen::Vector3f> points)
+      : cloud_(std::make_unique<Cloud>(Cloud{std::move(points)})), index_(std::make_unique<Index>(3, *cloud_)) {}
 
-  std::size_t size() const { return points_.size(); }
+  std::size_t size() const { return cloud_->points.size(); }
 
   /// Squared distance to the nearest point (infinity for an empty tree).
   float nearestSquaredDistance(const Eigen::Vector3f& q) const {
-    float best = std::numeric_limits<float>::infinity();
-    if (!points_.empty()) search(0, q, best);
-    return best;
+    if (cloud_->points.empty()) return std::numeric_limits<float>::infinity();
+    std::uint32_t nearest = 0;
+    float squared = 0.0f;
+    nanoflann::KNNResultSet<float, std::uint32_t> result(1);
+    result.init(&nearest, &squared);
+    index_->findNeighbors(result, q.data(), nanoflann::SearchParams());
+    return (cloud_->points[nearest] - q).squaredNorm();
   }
 
  private:
-  struct Node {
-    int begin, end;  // range of order_
-    Eigen::Vector3f lo, hi;  // bounding box of the node's points
-    int axis = -1;  // -1: leaf
-    float split = 0.0f;
-    int left = -1, right = -1;
-  };
-
-  int build(int begin, int end) {
-    const int id = int(nodes_.size());
-    Eigen::Vector3f lo = points_[order_[begin]], hi = lo;
-    for (int i = begin; i < end; ++i) lo = lo.cwiseMin(points_[order_[i]]), hi = hi.cwiseMax(points_[order_[i]]);
-    nodes_.push_back({begin, end, lo, hi});
-    if (end - begin <= 8) return id;
-    int axis;
-    (hi - lo).maxCoeff(&axis);
-    const int mid = (begin + end) / 2;
-    std::nth_element(order_.begin() + begin, order_.begin() + mid, order_.begin() + end,
-                     [&](int a, int b) { return points_[a][axis] < points_[b][axis]; });
-    const float split = points_[order_[mid]][axis];
-    const int left = build(begin, mid);
-    const int right = build(mid, end);
-    nodes_[id].axis = axis;
-    nodes_[id].split = split;
-    nodes_[id].left = left;
-    nodes_[id].right = right;
-    return id;
-  }
-
-  void search(int id, const Eigen::Vector3f& q, float& best) const {
-    const Node& node = nodes_[id];
-    if (node.axis < 0) {
-      for (int i = node.begin; i < node.end; ++i) best = std::min(best, (points_[order_[i]] - q).squaredNorm());
-      return;
+  /// The points as nanoflann's dataset adaptor sees them.
+  struct Cloud {
+    std::vector<Eigen::Vector3f> points;
+    std::size_t kdtree_get_point_count() const { return points.size(); }
+    float kdtree_get_pt(std::size_t i, std::size_t axis) const { return points[i][Eigen::Index(axis)]; }
+    template <typename Box>
+    bool kdtree_get_bbox(Box&) const {
+      return false;  // nanoflann computes the bounding box
     }
-    const bool left_first = q[node.axis] < node.split;
-    for (const int child : {left_first ? node.left : node.right, left_first ? node.right : node.left})
-      if (boxSquaredDistance(nodes_[child], q) < best) search(child, q, best);
-  }
+  };
+  using Index = nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<float, Cloud>, Cloud, 3, std::uint32_t>;
 
-  static float boxSquaredDistance(const Node& node, const Eigen::Vector3f& q) {
-    return (q - q.cwiseMax(node.lo).cwiseMin(node.hi)).squaredNorm();
-  }
-
-  std::vector<Eigen::Vector3f> points_;
-  std::vector<int> order_;
-  std::vector<Node> nodes_;
+  std::unique_ptr<Cloud> cloud_;  // on the heap: the index refers to it, and the tree stays movable
+  std::unique_ptr<Index> index_;
 };
 
 }  // namespace bundletrack

@@ -36,7 +36,7 @@ enum class MeanRow { Add, Omit };
 
 inline std::string formatScoreTable(const std::vector<NamedScore>& rows, MeanRow mean = MeanRow::Add) {
   std::string out;
-  char line[256];
+  char line[512];
   std::snprintf(line, sizeof(line), "%-24s %7s %7s %8s %7s %8s %8s %7s %8s\n", "sequence", "ADD", "ADD-S", "5deg5cm",
                 "IoU25", "R_err", "T_err", "frames", "missing");
   out += line;
@@ -55,6 +55,15 @@ inline std::string formatScoreTable(const std::vector<NamedScore>& rows, MeanRow
   };
   for (const auto& r : rows) row(r.sequence, r.score);
   if (rows.size() > 1 && mean == MeanRow::Add) row("mean", meanScore(rows));
+  // A large model is scored on a subsample (scoringSubsample): say so, with its bound.
+  for (const auto& r : rows) {
+    const SequenceScore& s = r.score;
+    if (s.scored_points == 0 || s.scored_points >= s.model_points) continue;
+    std::snprintf(line, sizeof(line), "%s: ADD and ADD-S on %zu of the model's %zu points (evenly strided); each ADD-S "
+                  "distance at most %.2f cm above the whole model's\n", r.sequence.c_str(), s.scored_points,
+                  s.model_points, s.subsample_bound_cm);
+    out += line;
+  }
   return out;
 }
 
