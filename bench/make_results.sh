@@ -24,6 +24,7 @@ solvers=$("$build/bin/bench_solvers" --benchmark_format=csv --benchmark_filter='
 assembly=$("$build/bin/bench_solvers" --benchmark_format=csv --benchmark_filter='Assemble' 2>/dev/null)
 selection=$("$build/bin/bench_solvers" --benchmark_format=csv --benchmark_filter='SelectKeyframes' 2>/dev/null)
 depth=$("$build/bin/bench_depth_processing" --benchmark_format=csv 2>/dev/null)
+scoring=$("$build/bin/bench_scoring" --benchmark_format=csv 2>/dev/null)
 {
   echo "# Benchmark results"
   echo
@@ -81,6 +82,18 @@ depth=$("$build/bin/bench_depth_processing" --benchmark_format=csv 2>/dev/null)
   echo "|---|---|"
   echo "$depth" | awk -F, '/^"BM_/ { gsub(/"/, "", $1); t[$1] = $3; order[++n] = $1 }
     END { for (i = 1; i <= n; i++) printf "| %s | %.2f |\n", order[i], t[order[i]] / t["BM_MakeFrame"] }'
+  echo
+  echo "## Scoring against large models (bench_scoring)"
+  echo
+  echo "Milliseconds as ratios to ADD of the same pose on the same model (no nearest-neighbour search);"
+  echo "arguments: model points, centimetres from the truth. scoreSequence (ten frames) scores a model"
+  echo "above 20000 points on an even subsample."
+  echo
+  echo "| benchmark | time / ADD of the same model and offset |"
+  echo "|---|---|"
+  echo "$scoring" | awk -F, '/^"BM_/ { gsub(/"/, "", $1); t[$1] = $3; order[++n] = $1 }
+    END { for (i = 1; i <= n; i++) { split(order[i], a, "/"); base = "BM_Add/" a[2] "/" (a[3] == "" ? 1 : a[3]);
+          printf "| %s | %.1f |\n", order[i], t[order[i]] / t[base] } }'
   echo
   echo "## Tracker per stage (bench_tracker, default tracker, masks given)"
   echo
