@@ -87,7 +87,7 @@ scoring=$("$build/bin/bench_scoring" --benchmark_format=csv 2>/dev/null)
   echo
   echo "Milliseconds as ratios to ADD of the same pose on the same model (no nearest-neighbour search);"
   echo "arguments: model points, centimetres from the truth. scoreSequence (ten frames) scores a model"
-  echo "above 20000 points on an even subsample."
+  echo "above 50000 points on an even subsample."
   echo
   echo "| benchmark | time / ADD of the same model and offset |"
   echo "|---|---|"

@@ -91,7 +91,7 @@ TEST_CASE("a large model is scored on a strided subsample whose ADD-S stays with
   CHECK(score.model_points == large.size());
   CHECK(score.scored_points == bt::kMostScoredPoints);
   CHECK(score.subsample_bound_cm > 0.0);
-  CHECK(bt::formatScoreTable({{"s", score}}).find("on 20000 of the model's 40000 points") != std::string::npos);
+  CHECK(bt::formatScoreTable({{"s", score}}).find("on 50000 of the model's 100000 points") != std::string::npos);
 }
 
 TEST_CASE("oriented box IoU on hand-computed configurations") {

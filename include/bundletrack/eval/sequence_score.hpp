@@ -38,7 +38,8 @@ struct ScoringSubsample {
   double bound = 0.0;  ///< metres
 };
 
-inline constexpr std::size_t kMostScoredPoints = 20000;
+/// Models of up to this many points (the shared sequences' have 6.6k-24k) are scored whole.
+inline constexpr std::size_t kMostScoredPoints = 50000;
 
 inline ScoringSubsample scoringSubsample(const std::vector<Eigen::Vector3f>& model, std::size_t most = kMostScoredPoints) {
   ScoringSubsample subsample;
