@@ -405,7 +405,7 @@ struct FrameData {
   std::vector<std::optional<cv::Mat>> masks;
 };
 
-int run(bt::MultiObjectTracker& tracker, const bt::io::RgbdSequence& sequence, const std::vector<std::string>& objects,
+void run(bt::MultiObjectTracker& tracker, const bt::io::RgbdSequence& sequence, const std::vector<std::string>& objects,
         const Options& options) {
   const bool propagated = options.config.masks == "propagated";
   const bool several = !sequence.objects().empty();
@@ -548,13 +548,16 @@ int run(bt::MultiObjectTracker& tracker, const bt::io::RgbdSequence& sequence, c
     for (std::size_t k = 0; k < count; ++k)
       if (const auto plot = outputs[k]->plotErrors()) std::printf("error plot: %s\n", plot->string().c_str());
   }
-  return 0;
 }
+
+/// Writes a small text file; a failure to do so is left to the run's own output checks.
+void writeText(const fs::path& path, const std::string& text) { std::ofstream(path) << text; }
 
 }  // namespace
 
 int main(int argc, char** argv) {
   Options options;
+  fs::path incomplete;  // OUT/INCOMPLETE once the output exists
   bool print_config = false;
   std::vector<std::pair<std::string, std::string>> overrides;
   for (int i = 1; i < argc; ++i) {
@@ -611,13 +614,21 @@ int main(int argc, char** argv) {
     std::vector<fs::path> folders = {"poses"};
     if (config.masks == "propagated") folders.push_back("masks");
     for (const std::string& object : objects) prepareOutput(options.out / object, folders);
+    // Until the run ends well, OUT says that what it holds is partial, and after an error why.
+    incomplete = options.out / "INCOMPLETE";
+    writeText(incomplete, "bundletrack_track has not finished: the outputs here cover only the frames written so far\n");
     const bt::PinholeCameraf camera = sequence.camera().cast<float>();
     bt::MultiObjectTracker tracker(objects.size(), [&] { return bt::makeTracker(config, camera); });
-    return run(tracker, sequence, objects, options);
+    run(tracker, sequence, objects, options);
+    fs::remove(incomplete);
+    return 0;
   } catch (const std::invalid_argument& error) {
     fail(error.what());
   } catch (const std::exception& error) {
     std::cerr << "\nerror: " << error.what() << '\n';
+    if (!incomplete.empty())
+      writeText(incomplete, std::string("bundletrack_track stopped with an error; the outputs here are partial:\n") +
+                                error.what() + '\n');
     return 1;
   }
 }

@@ -6,7 +6,8 @@
 # model (needed only for the scores) stops the run before any frame is tracked. bundletrack_eval
 # scores a sequence without depth/ and masks/ as it scores the whole one. A run that tracks nothing
 # after the first frame prints no frame rate. An --out that cannot take the results (a file, a link
-# loop, a name too long) and a directory where cam_K.txt belongs are refused, naming the cause.
+# loop, a name too long) and a directory where cam_K.txt belongs are refused, naming the cause. A
+# run that stops leaves OUT/INCOMPLETE with the error; a finished one none.
 # Usage: bad_frames.sh BUNDLETRACK_SYNTH BUNDLETRACK_TRACK BUNDLETRACK_EVAL WORK_DIR
 set -euo pipefail
 synth=$1 track=$2 eval=$3 work=$4
@@ -41,6 +42,10 @@ if "$track" --sequence "$work/seq" --out "$work/strict" --quiet --strict > /dev/
   fail "--strict did not stop at the bad depth file"
 fi
 grep -q "depth/000003.png" "$work/strict.txt" || fail "--strict error: $(cat "$work/strict.txt")"
+# The partial output of a run that stopped says so (OUT/INCOMPLETE, with the error); a finished run leaves none.
+grep -q "stopped with an error" "$work/strict/INCOMPLETE" && grep -q "depth/000003.png" "$work/strict/INCOMPLETE" \
+  || fail "no INCOMPLETE marker after --strict stopped: $(cat "$work/strict/INCOMPLETE" 2>&1)"
+[ ! -e "$work/out/INCOMPLETE" ] || fail "a finished run left OUT/INCOMPLETE"
 
 cp -r "$work/seq" "$work/truth_only" && rm -r "$work/truth_only/depth" "$work/truth_only/masks"
 "$eval" --sequence "$work/seq" --poses "$work/out/poses" | sed -n 2p | cut -c25- > "$work/eval_whole.txt"
