@@ -5,6 +5,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <regex>
 #include <sstream>
 #include <string>
 #include <string_view>
@@ -100,7 +101,27 @@ inline void requireConsistent(const Config& config, const std::filesystem::path&
 /// An unknown key, a key or section given twice, a value that is not a number, a non-integer for
 /// an integer setting, a value out of range, a name that is not among a choice's or settings that
 /// contradict each other (requireConsistent) is an InputError naming the file and key.
+/// The settings file's shape, checked line by line before OpenCV parses it: comments, blank
+/// lines, the YAML directive and document start, "section:" at the margin and indented
+/// "key: value". OpenCV's YAML parser loops without end on some malformed text (found by
+/// fuzz_config), so nothing else reaches it.
+inline void requireSettingsShape(const std::string& yaml, const std::filesystem::path& path) {
+  static const std::regex blank(R"(\s*(#.*)?)"), header(R"((%YAML.*|---\s*))"),
+      section(R"([A-Za-z_][A-Za-z0-9_]*[ \t]*:[ \t]*(#.*)?)"), entry(R"([ \t]+[A-Za-z_][A-Za-z0-9_]*[ \t]*:[ \t]*[^ \t#].*)");
+  std::istringstream lines(yaml);
+  std::string line;
+  for (int number = 1; std::getline(lines, line); ++number) {
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    if (std::regex_match(line, blank) || std::regex_match(line, header) || std::regex_match(line, section) ||
+        std::regex_match(line, entry))
+      continue;
+    throw InputError(path, "line " + std::to_string(number) + ": expected 'section:' at the margin or an indented "
+                           "'key: value' (the settings are sections of key: value pairs), got '" + line.substr(0, 60) + "'");
+  }
+}
+
 inline Config parseConfig(std::string yaml, const std::filesystem::path& path) {
+  requireSettingsShape(yaml, path);
   if (yaml.rfind("%YAML", 0) != 0) yaml = "%YAML:1.0\n---\n" + yaml;  // OpenCV needs the directive
   cv::FileStorage storage;
   try {
