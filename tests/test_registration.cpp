@@ -192,3 +192,40 @@ TEST_CASE("mutual matching with the ratio test is symmetric and gated by a known
   for (const auto& m : bt::matchFeatures(a, b, settings, bt::MatchGate{shifted, 0.02f, 45.0f}))
     CHECK(m.first != m.second + 10);
 }
+
+TEST_CASE("guided matching equals the exhaustive loop over the pairs the gate admits") {
+  // Keypoints 1 cm apart on average, descriptors clustered so that several candidates per gate
+  // compete, a gate of 2 cm and 45 degrees under a known pose: the reference offers every pair.
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<float> coord(-0.06f, 0.06f), unit(0.0f, 1.0f);
+  std::normal_distribution<float> normal;
+  const bt::SE3d T = randomPose(rng, 0.3);
+  bt::FrameFeatures a, b;
+  makeCorrespondingFeatures(rng, T, 400, a, b);
+  for (auto& p : b.points) p += 0.004f * Eigen::Vector3f(normal(rng), normal(rng), normal(rng));
+  a.descriptors.create(400, 8, CV_32F);
+  b.descriptors.create(400, 8, CV_32F);
+  for (int r = 0; r < 400; ++r)
+    for (int c = 0; c < 8; ++c) {
+      a.descriptors.at<float>(r, c) = float(r % 5) + unit(rng);
+      b.descriptors.at<float>(r, c) = float(r % 5) + unit(rng);
+    }
+  const bt::MatchGate gate{T.cast<float>(), 0.02f, 45.0f};
+  std::vector<bt::TwoNearest> forward(400), backward(400);
+  const auto bounds = gate.surface.bounds<float>();
+  for (int i = 0; i < 400; ++i)
+    for (int j = 0; j < 400; ++j) {
+      const Eigen::Vector3f moved = gate.T_second_first * a.points[std::size_t(i)];
+      const Eigen::Vector3f normal_moved = gate.T_second_first.rotation() * a.normals[std::size_t(i)];
+      if (!bounds.admits((moved - b.points[std::size_t(j)]).squaredNorm(), normal_moved.dot(b.normals[std::size_t(j)])))
+        continue;
+      const float d = bt::descriptorDistance(a.descriptors.row(i), b.descriptors.row(j), cv::NORM_L2);
+      forward[std::size_t(i)].offer(d, j);
+      backward[std::size_t(j)].offer(d, i);
+    }
+  const bt::MatchSettings settings;
+  const auto expected = bt::mutualMatches(forward, backward, a, b, settings.ratio, std::nullopt);
+  const auto guided = bt::matchFeatures(a, b, settings, gate);
+  CHECK(expected.size() > 20);
+  CHECK(guided == expected);
+}

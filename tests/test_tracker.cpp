@@ -88,7 +88,7 @@ using PropagatedTracker =
 
 }  // namespace
 
-TEST_CASE("full tracker on a synthetic hand-held box: ADD-S AUC >= 95 and less drift than the coarse tracker") {
+TEST_CASE("full tracker on a synthetic hand-held box: ADD-S AUC >= 95 and less drift than the coarse tracker" * doctest::test_suite("end_to_end")) {
   synth::SyntheticSequenceSettings settings;
   settings.frames = 60;
   settings.speed = 2.0;  // the box turns by 160 degrees over the 60 frames
@@ -107,7 +107,7 @@ TEST_CASE("full tracker on a synthetic hand-held box: ADD-S AUC >= 95 and less d
   CHECK(full.score.final_add_cm < coarse.score.final_add_cm);
 }
 
-TEST_CASE("from the first mask alone: propagated masks track the hand-held box as well as given masks") {
+TEST_CASE("from the first mask alone: propagated masks track the hand-held box as well as given masks" * doctest::test_suite("end_to_end")) {
   synth::SyntheticSequenceSettings settings;
   settings.frames = 60;
   settings.speed = 2.0;
@@ -145,7 +145,7 @@ TEST_CASE("feature-only and dense-only energies compose and track, and dense alo
   CHECK(features.score.adds_auc >= 95.0);
 }
 
-TEST_CASE("keypoints on demand: frames the surface holds skip them, as accurate as keypoints on every frame") {
+TEST_CASE("keypoints on demand: frames the surface holds skip them and track as well as keypoints on every frame" * doctest::test_suite("end_to_end")) {
   synth::SyntheticSequenceSettings settings;
   settings.frames = 40;
   settings.shape = synth::Shape::Chair;  // legs, seat and back: most views hold every direction
@@ -177,7 +177,7 @@ TEST_CASE("keypoints on demand: frames the surface holds skip them, as accurate 
   CHECK(largestDifference(never, every) == 0.0);
 }
 
-TEST_CASE("a textureless mug hidden by a passing arm is re-acquired by its surface, not lost for good") {
+TEST_CASE("a textureless mug hidden by a passing arm is re-acquired by its surface and not lost for good" * doctest::test_suite("end_to_end")) {
   synth::SyntheticSequenceSettings settings;
   settings.frames = 120;  // the arm crosses the mug around frame 60
   settings.shape = synth::Shape::Mug;
@@ -199,7 +199,7 @@ TEST_CASE("a textureless mug hidden by a passing arm is re-acquired by its surfa
   CHECK(surface.score.adds_auc >= 90.0);
 }
 
-TEST_CASE("a textureless box 2.5 m from a structured-light camera is tracked with no frame lost") {
+TEST_CASE("a textureless box 2.5 m from a structured-light camera is tracked with no frame lost" * doctest::test_suite("end_to_end")) {
   synth::SyntheticSequenceSettings settings;
   settings.frames = 60;
   settings.distance = 2.5;  // sigma 9.6 mm and disparity steps of 17 mm on the box
@@ -220,7 +220,7 @@ TEST_CASE("a textureless box 2.5 m from a structured-light camera is tracked wit
   CHECK(run.score.adds_auc >= 85.0);
 }
 
-TEST_CASE("after the object was out of view, it is re-acquired with fewer than 12 keypoints per frame") {
+TEST_CASE("after the object was out of view it is re-acquired with fewer than 12 keypoints per frame" * doctest::test_suite("end_to_end")) {
   synth::SyntheticSequenceSettings settings;
   settings.frames = 80;
   settings.distance = 2.5;
@@ -277,7 +277,7 @@ TEST_CASE("after the object was out of view, it is re-acquired with fewer than 1
   CHECK(run(features_only).first_recovered == -1);  // features alone never come back
 }
 
-TEST_CASE("a textureless chair 2.5 m away comes back 27 degrees turned: re-acquired on return by its surface") {
+TEST_CASE("a textureless chair 2.5 m away comes back 27 degrees turned: re-acquired on return by its surface" * doctest::test_suite("end_to_end")) {
   synth::SyntheticSequenceSettings settings;  // the stress matrix's D_chair_2.5m_textureless_out_of_view
   settings.frames = 62;
   settings.shape = synth::Shape::Chair;
@@ -351,11 +351,11 @@ void checkOutOfView(bool first_mask_only) {
   CHECK(wrong == 0);
 }
 
-TEST_CASE("object out of view for 30 frames, given masks: lost while gone, recovered on return, no wrong pose") {
+TEST_CASE("object out of view for 30 frames with given masks: lost while gone and recovered on return with no wrong pose" * doctest::test_suite("end_to_end")) {
   checkOutOfView<bt::DefaultTracker>(false);
 }
 
-TEST_CASE("object out of view for 30 frames, first mask only: lost while gone, found again on return") {
+TEST_CASE("object out of view for 30 frames from the first mask only: lost while gone and found again on return" * doctest::test_suite("end_to_end")) {
   checkOutOfView<PropagatedTracker>(true);
 }
 
@@ -374,7 +374,7 @@ double distanceToTriangle(const Eigen::Vector3d& p, const Eigen::Vector3d& a, co
   return std::min({to_segment(a, b), to_segment(b, c), to_segment(c, a)});
 }
 
-TEST_CASE("the object model fused from the keyframes lies on the true surface within the sensor's noise") {
+TEST_CASE("the object model fused from the keyframes lies on the true surface within the sensor's noise" * doctest::test_suite("end_to_end")) {
   const ShortScene short_scene(90);
   bt::DefaultTracker tracker(short_scene.camera());
   const Run run = track(tracker, short_scene.scene, short_scene.model);
@@ -434,7 +434,7 @@ TEST_CASE("makeTracker builds the tracker composed at compile time: the same pos
   CHECK(largestDifference(track(*bt::makeTracker(config, short_scene.camera()), scene, model, true), made) == 0.0);
 }
 
-TEST_CASE("frames preprocessed only inside the tracker's region of interest give the same poses, bit for bit") {
+TEST_CASE("frames preprocessed only inside the tracker's region of interest give the same poses bit for bit" * doctest::test_suite("end_to_end")) {
   // Given masks: the mask's box; propagated: around the last pose's silhouette; after the object
   // was out of view: the whole image until it is found again.
   synth::SyntheticSequenceSettings settings;
