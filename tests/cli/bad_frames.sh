@@ -4,7 +4,8 @@
 # the three unreadable frames are reported lost with their reason and scored as failures, frame 5
 # is tracked but not scored; with --strict the first bad file stops the run, naming it. An empty
 # model (needed only for the scores) stops the run before any frame is tracked. bundletrack_eval
-# scores a sequence without depth/ and masks/ as it scores the whole one. A run that tracks nothing
+# scores a sequence without depth/ and masks/ as it scores the whole one, and scores lost frames
+# as failures from the run's track.csv as bundletrack_track does. A run that tracks nothing
 # after the first frame prints no frame rate. An --out that cannot take the results (a file, a link
 # loop, a name too long) and a directory where cam_K.txt belongs are refused, naming the cause. A
 # run that stops leaves OUT/INCOMPLETE with the error; a finished one none.
@@ -60,6 +61,19 @@ cp -r "$work/seq" "$work/truth_only" && rm -r "$work/truth_only/depth" "$work/tr
 grep -q "6 frames, 5 lost" "$work/gone.txt" || fail "out of view: $(head -1 "$work/gone.txt")"
 grep -q "no frame after the first was tracked" "$work/gone.txt" || fail "out of view: no notice"
 ! grep -q "fps" "$work/gone.txt" || fail "a frame rate without a tracked frame: $(grep fps "$work/gone.txt")"
+# bundletrack_eval reads the lost frames from the run's track.csv: its second table is the
+# tracker's own "(lost=failed)" row; a track.csv without rows for the poses' frames is refused.
+"$eval" --sequence "$work/gone" --poses "$work/gone_out/poses" > "$work/gone_eval.txt" || fail "eval of the lost run: exit $?"
+grep -q "gone: 5 of the scored frames reported lost" "$work/gone_eval.txt" || fail "eval lost count: $(head -1 "$work/gone_eval.txt")"
+grep "^gone (lost=failed)" "$work/gone.txt" | cut -c25- > "$work/lost_track.txt"
+sed -n '/lost frames scored as failures/,$p' "$work/gone_eval.txt" | grep "^gone " | cut -c25- > "$work/lost_eval.txt"
+[ -s "$work/lost_track.txt" ] && cmp -s "$work/lost_track.txt" "$work/lost_eval.txt" \
+  || fail "lost=failed scores differ: $(cat "$work/lost_track.txt") / $(cat "$work/lost_eval.txt")"
+head -2 "$work/gone_out/track.csv" > "$work/cut.csv" && mv "$work/cut.csv" "$work/gone_out/track.csv"
+if "$eval" --sequence "$work/gone" --poses "$work/gone_out/poses" > /dev/null 2> "$work/gone_eval_err.txt"; then
+  fail "eval accepted a track.csv without rows for the poses"
+fi
+grep -q "track.csv: no row for frame 000001" "$work/gone_eval_err.txt" || fail "eval: $(cat "$work/gone_eval_err.txt")"
 
 : > "$work/seq/model/points.xyz"
 if "$track" --sequence "$work/seq" --out "$work/no_model" --quiet > /dev/null 2> "$work/no_model.txt"; then

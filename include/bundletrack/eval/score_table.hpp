@@ -67,8 +67,11 @@ inline std::string formatScoreTable(const std::vector<NamedScore>& rows, MeanRow
   return out;
 }
 
-/// JSON with one object per sequence and the mean: ADD, ADD_S, deg5cm5, IoU25, Rerr_deg, Terr_cm, frames.
-inline void writeScoreJson(const std::filesystem::path& path, const std::vector<NamedScore>& rows) {
+/// JSON with one object per sequence and the mean: ADD, ADD_S, deg5cm5, IoU25, Rerr_deg, Terr_cm,
+/// frames, missing. With `lost_as_failed` (the same sequences, the frames the tracker reported
+/// lost scored as failures), the same again under "lost_as_failed".
+inline void writeScoreJson(const std::filesystem::path& path, const std::vector<NamedScore>& rows,
+                           const std::vector<NamedScore>& lost_as_failed = {}) {
   std::ofstream out(path);
   if (!out) throw InputError(path, "cannot write file");
   const auto number = [](double v) { return std::isfinite(v) ? std::to_string(v) : std::string("null"); };
@@ -83,10 +86,15 @@ inline void writeScoreJson(const std::filesystem::path& path, const std::vector<
            ", \"Rerr_deg\": " + number(s.rotation_error_deg) + ", \"Terr_cm\": " + number(s.translation_error_cm) +
            ", \"frames\": " + std::to_string(s.frames) + ", \"missing\": " + std::to_string(s.missing) + "}";
   };
-  out << "{\n  \"sequences\": [\n";
-  for (std::size_t k = 0; k < rows.size(); ++k)
-    out << "    " << object(rows[k].sequence, rows[k].score) << (k + 1 < rows.size() ? ",\n" : "\n");
-  out << "  ],\n  \"mean\": " << object("mean", meanScore(rows)) << "\n}\n";
+  const auto table = [&](const std::vector<NamedScore>& scores, const std::string& indent) {
+    std::string text = indent + "\"sequences\": [\n";
+    for (std::size_t k = 0; k < scores.size(); ++k)
+      text += indent + "  " + object(scores[k].sequence, scores[k].score) + (k + 1 < scores.size() ? ",\n" : "\n");
+    return text + indent + "],\n" + indent + "\"mean\": " + object("mean", meanScore(scores));
+  };
+  out << "{\n" << table(rows, "  ");
+  if (!lost_as_failed.empty()) out << ",\n  \"lost_as_failed\": {\n" << table(lost_as_failed, "    ") << "\n  }";
+  out << "\n}\n";
   if (!out) throw InputError(path, "write failed");
 }
 
