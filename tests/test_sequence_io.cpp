@@ -117,6 +117,23 @@ TEST_CASE("bad input raises InputError naming the file and the problem") {
     fs::create_directory(root / "cam_K.txt");
     checkInputError(open, root / "cam_K.txt", "is a directory");
   }
+  SUBCASE("depth in 0.1 mm read as millimetres") {
+    // The wall at 1 m and the object at 0.8 m read as 10 m and 8 m: the object's depth is one a
+    // sensor could measure, the whole frame's median is beyond twice a Kinect's 4 m.
+    for (const char* name : {"1", "2", "10"}) {
+      cv::Mat depth(60, 80, CV_16UC1, cv::Scalar(10000));
+      depth(cv::Rect(30, 20, 20, 20)).setTo(8000);
+      cv::imwrite((root / "depth" / (std::string(name) + ".png")).string(), depth);
+    }
+    checkInputError(open, root / "depth" / "1.png", "median depth of the whole first frame is 10.000000 m");
+    checkInputError(open, root / "depth" / "1.png", "images in 0.1 mm need 0.0001");
+    bt::io::SequenceSettings settings;
+    settings.depth_scale = 0.0001;
+    CHECK(bt::io::RgbdSequence(root, settings).frame(0).depth.at<float>(30, 40) == doctest::Approx(0.8f));
+    settings.depth_scale = 0.0;
+    settings.frame.sensor = bt::DepthNoise::activeStereo();  // specified to 10 m: 10 m is within twice that
+    CHECK(bt::io::RgbdSequence(root, settings).frame(0).depth.at<float>(30, 40) == doctest::Approx(8.0f));
+  }
   SUBCASE("missing first mask") {
     fs::remove(root / "masks" / "1.png");
     checkInputError(open, root / "masks" / "1.png", "needs an object mask");

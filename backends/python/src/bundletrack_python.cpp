@@ -216,7 +216,7 @@ class PyTracker {
     if (mask.is_none()) throw bt::InputError("mask", "the first frame needs the object's mask");
     const cv::Mat object = maskArgument(mask, size);
     if (cv::countNonZero(object) == 0) throw bt::InputError("mask", "the first frame's object mask is empty");
-    bt::io::checkDepthScale(metres, object, arrayDepthScale(), "depth");
+    bt::io::checkDepthScale(metres, object, arrayDepthScale(), "depth", config_.sequence.frame.sensor.max_range);
     const bt::SE3d T_cam_obj = pose.is_none() ? bt::SE3d() : poseArgument(pose, "pose");
     std::unique_ptr<bt::AnyTracker> tracker = bt::makeTracker(config_, camera.cast<float>());
     bt::TrackResult result;

@@ -29,12 +29,17 @@ struct DepthNoise {
   double subpixel = 0.0;  ///< pixels: RMS of the disparity (stereo term)
   double baseline = 0.075;  ///< metres: projector-camera or stereo baseline
   double disparity_step = 0.0;  ///< pixels: disparity quantisation (0: none)
+  /// Metres: the farthest depth the sensor's specification covers (0: unknown). Only the depth
+  /// unit check reads it (io::checkDepthScale).
+  double max_range = 0.0;
 
   bool operator==(const DepthNoise&) const = default;
 
-  static DepthNoise structuredLight() { return {0.0012, 0.0, 0.0019, 0.4, 0.0, 0.075, 0.125}; }
-  static DepthNoise activeStereo() { return {0.0, 0.0, 0.0, 0.0, 0.08, 0.05, 0.0}; }
-  static DepthNoise timeOfFlight() { return {0.0, 0.017 / 3.86, 0.0, 0.0, 0.0, 0.075, 0.0}; }
+  /// Ranges: Kinect v1 0.8-4 m (default mode), RealSense D435 up to 10 m, Azure Kinect NFOV
+  /// (2x2 binned) 0.5-5.46 m.
+  static DepthNoise structuredLight() { return {0.0012, 0.0, 0.0019, 0.4, 0.0, 0.075, 0.125, 4.0}; }
+  static DepthNoise activeStereo() { return {0.0, 0.0, 0.0, 0.0, 0.08, 0.05, 0.0, 10.0}; }
+  static DepthNoise timeOfFlight() { return {0.0, 0.017 / 3.86, 0.0, 0.0, 0.0, 0.075, 0.0, 5.46}; }
 
   double sigma(double z, double focal_px) const {
     return base + linear * z + quadratic * (z - offset) * (z - offset) + z * z * subpixel / (focal_px * baseline);

@@ -1,6 +1,7 @@
 #pragma once
 
 #include <algorithm>
+#include <cstdio>
 #include <filesystem>
 #include <iterator>
 #include <string>
@@ -89,25 +90,45 @@ inline cv::Mat depthFromImage(const cv::Mat& raw, double scale, const std::files
   return metres;
 }
 
-/// The commonest mistake with a new dataset is the depth unit: the object's median depth (metres,
-/// `depth` under `mask`) must lie between 5 cm and 20 m, the range of any RGB-D sensor. `scale`
-/// is the unit the depth was read with, `source` names the depth in the error.
-inline void checkDepthScale(const cv::Mat& depth, const cv::Mat& mask, double scale, const std::filesystem::path& source) {
-  std::vector<float> values;
-  for (int v = 0; v < depth.rows; ++v)
-    for (int u = 0; u < depth.cols; ++u)
-      if (mask.at<uchar>(v, u) && depth.at<float>(v, u) > 0.0f) values.push_back(depth.at<float>(v, u));
-  if (values.empty()) throw InputError(source, "no valid depth under the first frame's object mask");
-  std::nth_element(values.begin(), values.begin() + std::ptrdiff_t(values.size() / 2), values.end());
-  const double median = values[values.size() / 2];
-  const std::string stated =
-      "median object depth is " + std::to_string(median) + " m with depth scale " + std::to_string(scale) + " m/unit";
-  if (median < 0.05)
+/// The commonest mistake with a new dataset is the depth unit. A depth map read with the wrong
+/// unit is a valid depth map of the scene scaled (shape and angles are kept), so only ranges can
+/// tell: the object's median depth (metres, `depth` under `mask`) must lie between 5 cm and 20 m,
+/// the range of any RGB-D sensor, and the median depth of the whole frame within twice
+/// `max_range`, the farthest depth the sensor's specification covers (DepthNoise::max_range;
+/// 0: not checked). Twice, because sensors report beyond their specified range and a room's far
+/// wall may lie there; an object 1 m away read in 0.1 mm units with millimetres' 0.001 seems 10 m
+/// away. `scale` is the unit the depth was read with, `source` names the depth in the error.
+inline void checkDepthScale(const cv::Mat& depth, const cv::Mat& mask, double scale, const std::filesystem::path& source,
+                            double max_range = 0.0) {
+  const auto median = [&](bool whole_frame) {
+    std::vector<float> values;
+    for (int v = 0; v < depth.rows; ++v)
+      for (int u = 0; u < depth.cols; ++u)
+        if ((whole_frame || mask.at<uchar>(v, u)) && depth.at<float>(v, u) > 0.0f) values.push_back(depth.at<float>(v, u));
+    if (values.empty()) return 0.0;
+    std::nth_element(values.begin(), values.begin() + std::ptrdiff_t(values.size() / 2), values.end());
+    return double(values[values.size() / 2]);
+  };
+  const double object = median(false);
+  if (object == 0.0) throw InputError(source, "no valid depth under the first frame's object mask");
+  const std::string with_scale = " with depth scale " + std::to_string(scale) + " m/unit";
+  const std::string stated = "median object depth is " + std::to_string(object) + " m" + with_scale;
+  if (object < 0.05)
     throw InputError(source, stated + ": closer than any RGB-D sensor measures; the depth scale is probably too small"
                                       " (images in millimetres need 0.001, in 0.1 mm 0.0001)");
-  if (median > 20.0)
+  if (object > 20.0)
     throw InputError(source, stated + ": farther than any RGB-D sensor measures; the depth scale is probably too large"
                                       " (images in millimetres need 0.001, not 1)");
+  if (max_range <= 0.0) return;
+  const double frame = median(true);
+  if (frame > 2.0 * max_range) {
+    char range[32];
+    std::snprintf(range, sizeof(range), "%.2f", max_range);
+    throw InputError(source, "median depth of the whole first frame is " + std::to_string(frame) + " m" + with_scale +
+                                 ", more than twice the " + range + " m that the sensor (sensor.model) is specified "
+                                 "for: the depth scale is probably too large (images in 0.1 mm need 0.0001, TUM "
+                                 "RGB-D's 1/5000 0.0002) or sensor.model names another sensor");
+  }
 }
 
 /// The depth of an image file (depthFromImage).

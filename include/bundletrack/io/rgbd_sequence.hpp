@@ -62,13 +62,13 @@ class RgbdSequence {
       for (const std::string& object : objects_)
         if (const auto m = mask(0, object)) visible |= *m;
       if (cv::countNonZero(visible) == 0) visible.setTo(255);
-      checkDepthScale(rawDepth(0), visible, depth_scale_, depthPath(0));
+      checkDepthScale(rawDepth(0), visible, depth_scale_, depthPath(0), settings_.frame.sensor.max_range);
       return;
     }
     const auto first_mask = mask(0);
     if (!first_mask) throw InputError(maskPath(0), "the first frame needs an object mask: file not found");
     if (cv::countNonZero(*first_mask) == 0) throw InputError(maskPath(0), "the first frame's object mask is empty");
-    checkDepthScale(rawDepth(0), *first_mask, depth_scale_, depthPath(0));
+    checkDepthScale(rawDepth(0), *first_mask, depth_scale_, depthPath(0), settings_.frame.sensor.max_range);
   }
 
   /// The objects of a sequence with a folder of masks per object, in name order; empty for a
