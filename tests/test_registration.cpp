@@ -193,11 +193,67 @@ TEST_CASE("mutual matching with the ratio test is symmetric and gated by a known
     CHECK(m.first != m.second + 10);
 }
 
+TEST_CASE("exhaustive matching and descriptor distances equal OpenCV's brute-force matcher (L2 and Hamming)") {
+  // The reference: cv::BFMatcher's two nearest neighbours in each direction, then the mutual ratio
+  // test. Descriptors in clusters (SIFT-like floats, ORB-like bytes) so that the ratio test both
+  // passes and fails; equality is exact because both sides use OpenCV's distance kernels.
+  std::mt19937 rng(11);
+  const auto reference = [](const bt::FrameFeatures& a, const bt::FrameFeatures& b, float ratio) {
+    const cv::BFMatcher matcher(a.norm_type);
+    const auto nearest = [&](const cv::Mat& query, const cv::Mat& train) {
+      std::vector<std::vector<cv::DMatch>> knn;
+      matcher.knnMatch(query, train, knn, 2);
+      std::vector<bt::TwoNearest> two(knn.size());
+      for (std::size_t k = 0; k < knn.size(); ++k) two[k] = {knn[k][0].trainIdx, knn[k][0].distance, knn[k][1].distance};
+      return std::pair{two, knn};
+    };
+    const auto [forward, knn] = nearest(a.descriptors, b.descriptors);
+    for (int i = 0; i < a.descriptors.rows; ++i)
+      CHECK(bt::descriptorDistance(a.descriptors, i, b.descriptors, knn[std::size_t(i)][0].trainIdx, a.norm_type) ==
+            knn[std::size_t(i)][0].distance);
+    return bt::mutualMatches(forward, nearest(b.descriptors, a.descriptors).first, a, b, ratio, std::nullopt);
+  };
+  // a: random rows, its rows 200..229 copies of rows 0..29 (L2: 1e-3 apart), so b's copies of
+  // those are ambiguous and fail the ratio test; b: rows 0..149 noisy copies of a's rows, the rest
+  // random.
+  const auto features = [&](int rows, int cols, int type, int norm, const cv::Mat* copy_of, int copies, int shift) {
+    bt::FrameFeatures f;
+    f.norm_type = norm;
+    f.descriptors.create(rows, cols, type);
+    std::uniform_real_distribution<float> unit(0.0f, 1.0f);
+    std::uniform_int_distribution<int> byte(0, 255), bit(0, 7);
+    for (int r = 0; r < rows; ++r) {
+      f.points.emplace_back(0.0f, 0.0f, 0.7f), f.normals.emplace_back(0.0f, 0.0f, -1.0f);
+      const bool twin = r >= shift && r < shift + 30;
+      const cv::Mat* source = r < copies ? copy_of : twin ? &f.descriptors : nullptr;
+      const int from = r < copies ? r : r - shift;
+      const float noise = twin ? 1e-3f : 0.05f;
+      for (int c = 0; c < cols; ++c) {
+        if (type == CV_32F)
+          f.descriptors.at<float>(r, c) = source ? source->at<float>(from, c) + noise * (unit(rng) - 0.5f) : unit(rng);
+        else
+          f.descriptors.at<uchar>(r, c) =
+              source ? uchar(source->at<uchar>(from, c) ^ (!twin && c % 8 == 0 ? 1 << bit(rng) : 0)) : uchar(byte(rng));
+      }
+    }
+    return f;
+  };
+  const bt::MatchSettings settings;
+  for (const auto& [type, cols, norm] : {std::tuple{CV_32F, 128, int(cv::NORM_L2)}, std::tuple{CV_8U, 32, int(cv::NORM_HAMMING)}}) {
+    const bt::FrameFeatures a = features(300, cols, type, norm, nullptr, 0, 200);
+    const bt::FrameFeatures b = features(250, cols, type, norm, &a.descriptors, 150, 250);
+    const auto expected = reference(a, b, settings.ratio);
+    CHECK(expected.size() >= 100);  // most of the 120 unambiguous copies
+    CHECK(expected.size() <= 125);  // not the 30 ambiguous ones
+    CHECK(bt::matchFeatures(a, b, settings) == expected);
+  }
+}
+
 TEST_CASE("guided matching equals the exhaustive loop over the pairs the gate admits") {
   // Keypoints 1 cm apart on average, descriptors clustered so that several candidates per gate
   // compete, a gate of 2 cm and 45 degrees under a known pose: the reference offers every pair.
   std::mt19937 rng(3);
-  std::uniform_real_distribution<float> coord(-0.06f, 0.06f), unit(0.0f, 1.0f);
+  std::uniform_real_distribution<float> unit(0.0f, 1.0f);
   std::normal_distribution<float> normal;
   const bt::SE3d T = randomPose(rng, 0.3);
   bt::FrameFeatures a, b;
@@ -219,7 +275,7 @@ TEST_CASE("guided matching equals the exhaustive loop over the pairs the gate ad
       const Eigen::Vector3f normal_moved = gate.T_second_first.rotation() * a.normals[std::size_t(i)];
       if (!bounds.admits((moved - b.points[std::size_t(j)]).squaredNorm(), normal_moved.dot(b.normals[std::size_t(j)])))
         continue;
-      const float d = bt::descriptorDistance(a.descriptors.row(i), b.descriptors.row(j), cv::NORM_L2);
+      const float d = bt::descriptorDistance(a.descriptors, i, b.descriptors, j, cv::NORM_L2);
       forward[std::size_t(i)].offer(d, j);
       backward[std::size_t(j)].offer(d, i);
     }

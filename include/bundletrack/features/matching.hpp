@@ -4,6 +4,7 @@
 #include <optional>
 #include <vector>
 
+#include <opencv2/core/hal/hal.hpp>
 #include <opencv2/features2d.hpp>
 
 #include "bundletrack/core/se3.hpp"
@@ -29,16 +30,12 @@ struct MatchGate {
   SurfaceGate surface;
 };
 
-/// Distance between descriptor rows a and b (CV_32F rows under NORM_L2, CV_8U rows under NORM_HAMMING).
-inline float descriptorDistance(const cv::Mat& a, const cv::Mat& b, int norm_type) {
-  if (norm_type == cv::NORM_L2) {
-    const float* x = a.ptr<float>();
-    const float* y = b.ptr<float>();
-    float sum = 0.0f;
-    for (int k = 0; k < a.cols; ++k) sum += (x[k] - y[k]) * (x[k] - y[k]);
-    return std::sqrt(sum);
-  }
-  return float(cv::norm(a, b, norm_type));
+/// Distance between row i of descriptors a and row j of b (CV_32F rows under NORM_L2, CV_8U rows
+/// under NORM_HAMMING): the kernels of cv::BFMatcher, so guided and exhaustive matching compare
+/// the same numbers.
+inline float descriptorDistance(const cv::Mat& a, int i, const cv::Mat& b, int j, int norm_type) {
+  if (norm_type == cv::NORM_L2) return std::sqrt(cv::hal::normL2Sqr_(a.ptr<float>(i), b.ptr<float>(j), a.cols));
+  return float(cv::hal::normHamming(a.ptr<uchar>(i), b.ptr<uchar>(j), a.cols));
 }
 
 /// A MatchGate ready to test pairs: first's keypoint moved into the second frame once, then
@@ -104,7 +101,7 @@ inline std::vector<FeatureMatch> matchGuided(const FrameFeatures& first, const F
     const GateTest::Moved moved = test.move(i);
     for (int j = 0; j < n2; ++j) {
       if (!test.admits(moved, j)) continue;
-      const float distance = descriptorDistance(first.descriptors.row(i), second.descriptors.row(j), first.norm_type);
+      const float distance = descriptorDistance(first.descriptors, i, second.descriptors, j, first.norm_type);
       forward[std::size_t(i)].offer(distance, j);
       backward[std::size_t(j)].offer(distance, i);
     }
@@ -115,23 +112,25 @@ inline std::vector<FeatureMatch> matchGuided(const FrameFeatures& first, const F
 /// Mutual nearest neighbours in descriptor space with the ratio test applied in both directions,
 /// so match(a, b) is match(b, a) with the roles swapped (the original code took the union of the
 /// two directions instead), then the gate when there is one; with a gate and settings.guided,
-/// matchGuided instead. Sorted by the first index.
+/// matchGuided instead. One distance matrix serves both directions (cv::batchDistance, the
+/// kernel of cv::BFMatcher). Sorted by the first index.
 inline std::vector<FeatureMatch> matchFeatures(const FrameFeatures& first, const FrameFeatures& second,
                                                const MatchSettings& settings,
                                                const std::optional<MatchGate>& gate = std::nullopt) {
   if (gate && settings.guided) return matchGuided(first, second, settings, *gate);
   if (first.size() < 2 || second.size() < 2) return {};  // no second neighbour for the ratio test
-  const cv::BFMatcher matcher(first.norm_type);
-  const auto twoNearest = [&](const cv::Mat& query, const cv::Mat& train) {
-    std::vector<std::vector<cv::DMatch>> knn;
-    matcher.knnMatch(query, train, knn, 2);
-    std::vector<TwoNearest> nearest(knn.size());
-    for (std::size_t k = 0; k < knn.size(); ++k)
-      if (knn[k].size() == 2) nearest[k] = {knn[k][0].trainIdx, knn[k][0].distance, knn[k][1].distance};
-    return nearest;
-  };
-  return mutualMatches(twoNearest(first.descriptors, second.descriptors),
-                       twoNearest(second.descriptors, first.descriptors), first, second, settings.ratio, gate);
+  cv::Mat distances;  // first.size() x second.size(), CV_32F (Hamming counts are exact in a float)
+  cv::batchDistance(first.descriptors, second.descriptors, distances, first.norm_type == cv::NORM_L2 ? CV_32F : CV_32S,
+                    cv::noArray(), first.norm_type);
+  distances.convertTo(distances, CV_32F);
+  std::vector<TwoNearest> forward(first.size()), backward(second.size());
+  for (int i = 0; i < distances.rows; ++i)
+    for (int j = 0; j < distances.cols; ++j) {
+      const float distance = distances.at<float>(i, j);
+      forward[std::size_t(i)].offer(distance, j);
+      backward[std::size_t(j)].offer(distance, i);
+    }
+  return mutualMatches(forward, backward, first, second, settings.ratio, gate);
 }
 
 }  // namespace bundletrack
