@@ -83,21 +83,49 @@ TEST_CASE("smoothing reduces sensor noise on a plane and keeps depth steps") {
   cv::Mat noisy = truth.clone();
   for (int v = 0; v < noisy.rows; ++v)
     for (int u = 0; u < noisy.cols; ++u) noisy.at<float>(v, u) += noise(rng);
-  bt::DepthFilterSettings settings;
-  cv::Mat smoothed = noisy;
-  for (int pass = 0; pass < settings.smooth_passes; ++pass) smoothed = bt::smoothDepth(smoothed, settings);
-  const cv::Rect left(4, 4, 24, 56), right(36, 4, 24, 56);
-  const double rms_before = cv::norm(noisy(left), truth(left)) / std::sqrt(double(left.area()));
-  const double rms_after = cv::norm(smoothed(left), truth(left)) / std::sqrt(double(left.area()));
-  CHECK(rms_after < 0.5 * rms_before);
-  // Next to the step each side keeps its own level (a blurred step would read ~0.9 m there); the
-  // bound is 4 sigma of the raw noise because edge pixels may keep their raw reading.
-  for (int v = 4; v < 60; ++v) {
-    CHECK(std::abs(smoothed.at<float>(v, 31) - 0.8f) < 0.008f);
-    CHECK(std::abs(smoothed.at<float>(v, 32) - 1.0f) < 0.008f);
+  for (const bt::DepthSmoothing smoothing : {bt::DepthSmoothing::Mean, bt::DepthSmoothing::PlaneFit}) {
+    CAPTURE(int(smoothing));
+    bt::DepthFilterSettings settings;
+    settings.smoothing = smoothing;
+    cv::Mat smoothed = noisy;
+    for (int pass = 0; pass < settings.smooth_passes; ++pass) smoothed = bt::smoothDepth(smoothed, settings);
+    const cv::Rect left(4, 4, 24, 56), right(36, 4, 24, 56);
+    const double rms_before = cv::norm(noisy(left), truth(left)) / std::sqrt(double(left.area()));
+    const double rms_after = cv::norm(smoothed(left), truth(left)) / std::sqrt(double(left.area()));
+    CHECK(rms_after < 0.5 * rms_before);
+    // Next to the step each side keeps its own level (a blurred step would read ~0.9 m there); the
+    // bound is 4 sigma of the raw noise because edge pixels may keep their raw reading.
+    for (int v = 4; v < 60; ++v) {
+      CHECK(std::abs(smoothed.at<float>(v, 31) - 0.8f) < 0.008f);
+      CHECK(std::abs(smoothed.at<float>(v, 32) - 1.0f) < 0.008f);
+    }
+    // Away from the step the averaged noise (sigma ~0.7 mm) stays well under 4 mm everywhere.
+    CHECK(cv::norm(smoothed(right), truth(right), cv::NORM_INF) < 0.004);
   }
-  // Away from the step the averaged noise (sigma ~0.7 mm) stays well under 4 mm everywhere.
-  CHECK(cv::norm(smoothed(right), truth(right), cv::NORM_INF) < 0.004);
+}
+
+TEST_CASE("plane-fit smoothing keeps a slanted plane where the mean flattens it at a border") {
+  // A plane turned 60 degrees about the camera's y axis (3.5 mm of depth per pixel at 1 m), its
+  // right half invalid: next to the border the window holds neighbours on one side only. The
+  // mean moves those pixels by slope x the neighbours' mean offset (millimetres); the plane
+  // through them is the true plane, up to the depth's curvature in pixel coordinates (z is
+  // hyperbolic in u) and float rounding. Interior pixels: both stay on the plane.
+  const Eigen::Vector3f n = Eigen::Vector3f(std::sin(1.0472f), 0.0f, -std::cos(1.0472f)).normalized();
+  cv::Mat truth = planeDepth(n, -0.5f, {64, 64});
+  cv::Mat cut = truth.clone();
+  cut.colRange(32, 64).setTo(0.0f);
+  REQUIRE(truth.at<float>(32, 31) == doctest::Approx(1.0).epsilon(0.1));
+  const auto error = [&](bt::DepthSmoothing smoothing, cv::Rect where) {
+    bt::DepthFilterSettings settings;
+    settings.smoothing = smoothing;
+    cv::Mat smoothed = cut;
+    for (int pass = 0; pass < settings.smooth_passes; ++pass) smoothed = bt::smoothDepth(smoothed, settings);
+    return cv::norm(smoothed(where), truth(where), cv::NORM_INF);
+  };
+  const cv::Rect border(30, 4, 2, 56), interior(8, 8, 16, 48);
+  CHECK(error(bt::DepthSmoothing::Mean, border) > 0.002);
+  CHECK(error(bt::DepthSmoothing::PlaneFit, border) < 0.0002);
+  CHECK(error(bt::DepthSmoothing::PlaneFit, interior) < 0.0002);
 }
 
 TEST_CASE("range check zeroes non-finite and out-of-range depth") {
