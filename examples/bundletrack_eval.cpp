@@ -17,6 +17,7 @@
 #include "bundletrack/io/point_files.hpp"
 #include "bundletrack/io/pose_files.hpp"
 #include "bundletrack/io/rgbd_sequence.hpp"
+#include "bundletrack/tracking/track_result.hpp"
 
 namespace bt = bundletrack;
 namespace fs = std::filesystem;
@@ -39,9 +40,10 @@ std::optional<std::map<std::string, bool>> lostFrames(const fs::path& csv) {
     const std::size_t first = line.find(','), second = first == std::string::npos ? first : line.find(',', first + 1);
     if (second == std::string::npos) throw bt::InputError(csv, "line " + std::to_string(number) + ": expected frame,status,...");
     const std::string status = line.substr(first + 1, second - first - 1);
-    if (status != "tracked" && status != "coarse" && status != "lost" && status != "not_started")
+    const std::optional<bt::TrackStatus> tracker_status = bt::statusFromName(status);
+    if (!tracker_status && status != "not_started")  // bundletrack_track's row before an object's first frame
       throw bt::InputError(csv, "line " + std::to_string(number) + ": unknown status '" + status + "'");
-    lost[line.substr(0, first)] = status == "lost";
+    lost[line.substr(0, first)] = tracker_status == bt::TrackStatus::Lost;
   }
   return lost;
 }
@@ -76,10 +78,11 @@ Scored evaluate(const fs::path& sequence_dir, const fs::path& poses_dir, int& un
     truth.push_back(bt::io::readPose(true_pose));
     const fs::path file = poses_dir / (name + ".txt");
     estimate.push_back(fs::exists(file) ? std::optional(bt::io::readPose(file)) : std::nullopt);
-    if (lost && estimate.back() && !lost->count(name))
+    const auto row = lost ? lost->find(name) : std::map<std::string, bool>::const_iterator{};
+    if (lost && estimate.back() && row == lost->end())
       throw bt::InputError(csv, "no row for frame " + name + ", whose pose is in " + poses_dir.string() +
                                     ": not the track.csv of the run that wrote these poses");
-    const bool frame_lost = lost && lost->count(name) && lost->at(name);
+    const bool frame_lost = lost && row != lost->end() && row->second;
     lost_scored += frame_lost;
     estimate_unless_lost.push_back(frame_lost ? std::nullopt : estimate.back());
   }

@@ -1,5 +1,6 @@
 #pragma once
 
+#include <optional>
 #include <string_view>
 
 #include <opencv2/core.hpp>
@@ -21,6 +22,13 @@ inline std::string_view statusName(TrackStatus status) {
     case TrackStatus::CoarseOnly: return "coarse";
     default: return "lost";
   }
+}
+
+/// The status that statusName gives `name`; none for any other text.
+inline std::optional<TrackStatus> statusFromName(std::string_view name) {
+  for (const TrackStatus status : {TrackStatus::Tracked, TrackStatus::CoarseOnly, TrackStatus::Lost})
+    if (statusName(status) == name) return status;
+  return std::nullopt;
 }
 
 /// Wall-clock milliseconds spent per stage of one frame.
