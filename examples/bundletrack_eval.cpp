@@ -1,4 +1,4 @@
-// bundletrack_eval --sequence DIR --poses DIR [--sequence DIR --poses DIR ...] [--json FILE]
+// bundletrack_eval --sequence DIR --poses DIR [--sequence DIR --poses DIR ...] [--json FILE] [--in-view]
 // Scores pose files (<poses>/<frame name>.txt, 4x4 T_cam_obj) against each sequence's
 // annotated_poses/ and model/points.xyz; prints one row per sequence and their mean. A frame
 // without a pose file is a failure, never skipped; one without an annotated pose is not scored.
@@ -6,6 +6,9 @@
 // OUT/poses), the frames it reports lost are counted, and a second table (and JSON block
 // "lost_as_failed") scores them as failures, as bundletrack_track's own summary does: a lost
 // frame keeps the last pose, which the first table scores as an estimate.
+// --in-view scores only the frames in which the object is seen, those whose masks/<name>.png has
+// a pixel on the object (for synthetic sequences the renderer's exact mask), as benchmarks that
+// annotate only visible objects do; the frames left out are counted.
 #include <filesystem>
 #include <fstream>
 #include <iostream>
@@ -14,6 +17,7 @@
 #include <string>
 
 #include "bundletrack/eval/score_table.hpp"
+#include "bundletrack/io/image_files.hpp"
 #include "bundletrack/io/point_files.hpp"
 #include "bundletrack/io/pose_files.hpp"
 #include "bundletrack/io/rgbd_sequence.hpp"
@@ -25,7 +29,7 @@ namespace fs = std::filesystem;
 namespace {
 
 const char* const kUsage =
-    "usage: bundletrack_eval --sequence DIR --poses DIR [--sequence DIR --poses DIR ...] [--json FILE]\n";
+    "usage: bundletrack_eval --sequence DIR --poses DIR [--sequence DIR --poses DIR ...] [--json FILE] [--in-view]\n";
 
 /// Whether each frame of track.csv (columns frame,status,...) was reported lost; none without the file.
 std::optional<std::map<std::string, bool>> lostFrames(const fs::path& csv) {
@@ -55,8 +59,8 @@ struct Scored {
 
 /// Scoring needs only the frames' names (rgb/ or rgb.txt), the ground truth and the model: a sequence without
 /// depth/ or with an empty first mask is scored all the same. A frame without an annotated pose is
-/// not scored (counted in `unscored`).
-Scored evaluate(const fs::path& sequence_dir, const fs::path& poses_dir, int& unscored) {
+/// not scored (counted in `unscored`), nor, with `in_view`, one whose mask is empty (`out_of_view`).
+Scored evaluate(const fs::path& sequence_dir, const fs::path& poses_dir, bool in_view, int& unscored, int& out_of_view) {
   if (!fs::is_directory(sequence_dir)) throw bt::InputError(sequence_dir, "sequence directory not found");
   const std::vector<std::string> names =
       bt::io::frameFiles(sequence_dir, bt::io::Layout::Auto, bt::io::SequenceSettings().max_time_difference).names;
@@ -73,6 +77,10 @@ Scored evaluate(const fs::path& sequence_dir, const fs::path& poses_dir, int& un
     const fs::path true_pose = sequence_dir / "annotated_poses" / (name + ".txt");
     if (!fs::exists(true_pose)) {
       ++unscored;
+      continue;
+    }
+    if (in_view && cv::countNonZero(bt::io::readMask(sequence_dir / "masks" / (name + ".png"))) == 0) {
+      ++out_of_view;
       continue;
     }
     truth.push_back(bt::io::readPose(true_pose));
@@ -100,11 +108,16 @@ Scored evaluate(const fs::path& sequence_dir, const fs::path& poses_dir, int& un
 int main(int argc, char** argv) {
   std::vector<fs::path> sequences, poses;
   fs::path json;
+  bool in_view = false;
   for (int i = 1; i < argc; ++i) {
     const std::string arg = argv[i];
     if (arg == "--help" || arg == "-h") {
       std::cout << kUsage;
       return 0;
+    }
+    if (arg == "--in-view") {
+      in_view = true;
+      continue;
     }
     if (i + 1 >= argc) {
       std::cerr << "error: " << arg << " needs a value\n" << kUsage;
@@ -124,9 +137,9 @@ int main(int argc, char** argv) {
   }
   try {
     std::vector<bt::NamedScore> rows, lost_as_failed;
-    int unscored = 0;
+    int unscored = 0, out_of_view = 0;
     for (std::size_t k = 0; k < sequences.size(); ++k) {
-      const Scored scored = evaluate(sequences[k], poses[k], unscored);
+      const Scored scored = evaluate(sequences[k], poses[k], in_view, unscored, out_of_view);
       rows.push_back(scored.score);
       if (scored.lost_as_failed) lost_as_failed.push_back(*scored.lost_as_failed);
     }
@@ -138,6 +151,7 @@ int main(int argc, char** argv) {
     std::cout << bt::formatScoreTable(rows);
     if (!lost_as_failed.empty()) std::cout << "lost frames scored as failures:\n" << bt::formatScoreTable(lost_as_failed);
     if (unscored > 0) std::cout << unscored << " frames without an annotated pose were not scored\n";
+    if (in_view) std::cout << out_of_view << " frames with an empty mask (object out of view) were not scored (--in-view)\n";
     if (!json.empty()) bt::writeScoreJson(json, rows, lost_as_failed);
   } catch (const std::exception& error) {
     std::cerr << "error: " << error.what() << '\n';

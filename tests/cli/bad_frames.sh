@@ -5,7 +5,8 @@
 # is tracked but not scored; with --strict the first bad file stops the run, naming it. An empty
 # model (needed only for the scores) stops the run before any frame is tracked. bundletrack_eval
 # scores a sequence without depth/ and masks/ as it scores the whole one, and scores lost frames
-# as failures from the run's track.csv as bundletrack_track does. A run that tracks nothing
+# as failures from the run's track.csv as bundletrack_track does, and with --in-view only the
+# frames whose mask is not empty. A run that tracks nothing
 # after the first frame prints no frame rate. An --out that cannot take the results (a file, a link
 # loop, a name too long) and a directory where cam_K.txt belongs are refused, naming the cause. A
 # run that stops leaves OUT/INCOMPLETE with the error; a finished one none.
@@ -69,6 +70,18 @@ grep "^gone (lost=failed)" "$work/gone.txt" | cut -c25- > "$work/lost_track.txt"
 sed -n '/lost frames scored as failures/,$p' "$work/gone_eval.txt" | grep "^gone " | cut -c25- > "$work/lost_eval.txt"
 [ -s "$work/lost_track.txt" ] && cmp -s "$work/lost_track.txt" "$work/lost_eval.txt" \
   || fail "lost=failed scores differ: $(cat "$work/lost_track.txt") / $(cat "$work/lost_eval.txt")"
+# --in-view leaves out the frames whose mask is empty: the same rows as a copy of the sequence
+# without the annotated poses of those frames (the object is out of view in frames 3-6 of 10).
+"$synth" --out "$work/leaves" --frames 10 --out-of-view 3 4 > /dev/null
+"$track" --sequence "$work/leaves" --out "$work/leaves_out" --quiet > /dev/null || fail "leaves the view: exit $?"
+"$eval" --sequence "$work/leaves" --poses "$work/leaves_out/poses" --in-view > "$work/in_view.txt" || fail "--in-view: exit $?"
+grep -q "4 frames with an empty mask (object out of view) were not scored" "$work/in_view.txt" \
+  || fail "--in-view count: $(tail -1 "$work/in_view.txt")"
+mv "$work/leaves" "$work/seen" && rm "$work/seen/annotated_poses/00000"[3-6].txt
+"$eval" --sequence "$work/seen" --poses "$work/leaves_out/poses" | grep "^seen " | cut -c25- > "$work/seen_rows.txt"
+grep "^leaves " "$work/in_view.txt" | cut -c25- > "$work/in_view_rows.txt"
+grep -Eq " 6 +0$" "$work/in_view_rows.txt" && cmp -s "$work/seen_rows.txt" "$work/in_view_rows.txt" \
+  || fail "--in-view scores differ: $(cat "$work/in_view_rows.txt") / $(cat "$work/seen_rows.txt")"
 head -2 "$work/gone_out/track.csv" > "$work/cut.csv" && mv "$work/cut.csv" "$work/gone_out/track.csv"
 if "$eval" --sequence "$work/gone" --poses "$work/gone_out/poses" > /dev/null 2> "$work/gone_eval_err.txt"; then
   fail "eval accepted a track.csv without rows for the poses"
