@@ -33,6 +33,8 @@ const char* const kUsage = R"(usage: bundletrack_synth --out DIR [options]
                      of box, cylinder, mug it is not, passing in front of and behind it; their
                      masks, poses and models go to masks/<shape>/, annotated_poses/<shape>/ and
                      model/<shape>/ (1)
+  --labels           with --objects 2 | 3: one label image per frame, labels/<frame>.png (the k-th
+                     object labelled k, named in labels/objects.txt), instead of the folders of masks
   --seed N           random seed of textures and sensor noise (1)
   --layout L         ycbineoat (rgb/%06d.png, depth in mm) | tum (rgb.txt, depth.txt: 30 Hz timestamps,
                      depth 4 ms after colour, in 1/5000 m) (ycbineoat)
@@ -58,6 +60,7 @@ double number(const std::string& option, const char* text) {
 int main(int argc, char** argv) {
   bt::synth::SyntheticSequenceSettings settings;
   bt::io::Layout layout = bt::io::Layout::YcbInEoat;
+  bt::synth::MaskFiles mask_files = bt::synth::MaskFiles::Folders;
   std::string out;
   for (int i = 1; i < argc; ++i) {
     const std::string arg = argv[i];
@@ -112,6 +115,8 @@ int main(int argc, char** argv) {
       const double objects = number(arg, value());
       if (objects != 1.0 && objects != 2.0 && objects != 3.0) fail("--objects must be 1, 2 or 3");
       settings.objects = int(objects);
+    } else if (arg == "--labels") {
+      mask_files = bt::synth::MaskFiles::LabelImages;
     } else if (arg == "--seed") {
       settings.seed = unsigned(number(arg, value()));
     } else if (arg == "--layout") {
@@ -127,9 +132,10 @@ int main(int argc, char** argv) {
     }
   }
   if (out.empty()) fail("--out is required");
+  if (mask_files == bt::synth::MaskFiles::LabelImages && settings.objects == 1) fail("--labels needs --objects 2 or 3");
   try {
     const auto start = std::chrono::steady_clock::now();
-    bt::synth::writeSyntheticSequence(out, settings, layout);
+    bt::synth::writeSyntheticSequence(out, settings, layout, mask_files);
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     std::printf("wrote %d frames to %s in %.1f s\n", settings.frames, out.c_str(), seconds);
   } catch (const std::exception& error) {

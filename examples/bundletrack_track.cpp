@@ -65,7 +65,8 @@ const char* const kUsage = R"(usage: bundletrack_track --sequence DIR --out DIR 
                      default it is reported lost with the reason (track.csv: problem) and the run
                      goes on, the frame scored as a failure (without an annotated pose: not scored)
   --objects LIST     a sequence of several objects (masks/<object>/<frame>.png, one folder per
-                     object; annotated_poses/<object>/ and model/<object>/ likewise): the objects
+                     object, or label images labels/<frame>.png named by labels/objects.txt;
+                     annotated_poses/<object>/ and model/<object>/ likewise): the objects
                      to track, names separated by commas, or all (all). Each is tracked by its own
                      tracker from the first frame with a non-empty mask of it, at its annotated pose
                      there (else the identity), the frames read and preprocessed once for all of
@@ -118,7 +119,7 @@ std::vector<std::string> chosenObjects(const bt::io::RgbdSequence& sequence, con
   if (available.empty()) {
     if (!list.empty())
       fail("--objects " + list + ": " + (sequence.root() / "masks").string() +
-           " holds the masks of one object (masks/<frame>.png), not a folder per object");
+           " holds the masks of one object (masks/<frame>.png), not a folder per object nor label images");
     return {""};
   }
   if (list.empty() || list == "all") return available;
@@ -126,7 +127,7 @@ std::vector<std::string> chosenObjects(const bt::io::RgbdSequence& sequence, con
   std::stringstream items(list);
   for (std::string name; std::getline(items, name, ',');) {
     if (std::find(available.begin(), available.end(), name) == available.end())
-      fail("--objects: no object '" + name + "' in " + (sequence.root() / "masks").string() + " (it has " + names + ")");
+      fail("--objects: no object '" + name + "' in " + sequence.objectList().string() + " (it has " + names + ")");
     if (std::find(chosen.begin(), chosen.end(), name) != chosen.end()) fail("--objects names '" + name + "' twice");
     chosen.push_back(name);
   }
@@ -422,9 +423,15 @@ void run(bt::MultiObjectTracker& tracker, const bt::io::RgbdSequence& sequence, 
   // where the trackers will look (MultiObjectTracker::regionOfInterest).
   bt::io::ReadAhead<FrameData> files(sequence.size(), [&](std::size_t i) {
     FrameData data{sequence.read(i), {}};
-    for (const std::string& object : objects)
-      data.masks.push_back(!several ? (data.raw.mask.empty() ? std::nullopt : std::optional(data.raw.mask))
-                                    : sequence.mask(i, object));
+    if (!several) {
+      data.masks.push_back(data.raw.mask.empty() ? std::nullopt : std::optional(data.raw.mask));
+      return data;
+    }
+    std::vector<std::optional<cv::Mat>> all = sequence.masks(i);
+    for (const std::string& object : objects) {
+      const auto at = std::find(sequence.objects().begin(), sequence.objects().end(), object);
+      data.masks.push_back(std::move(all[std::size_t(at - sequence.objects().begin())]));
+    }
     return data;
   });
   bt::Stopwatch whole_run, progress;

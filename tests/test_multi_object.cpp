@@ -1,8 +1,12 @@
 // Several objects in one camera: the synthetic scene with two and three objects (their masks,
-// poses and occlusion against the renderer), the sequence layout with a folder per object, and
-// MultiObjectTracker against one tracker per object run alone (bit-identical) and against the
-// exact ground truth.
+// poses and occlusion against the renderer), the sequence layouts with a folder per object and
+// with label images, and MultiObjectTracker against one tracker per object run alone
+// (bit-identical) and against the exact ground truth.
 #include <doctest/doctest.h>
+
+#include <sstream>
+
+#include <opencv2/imgcodecs.hpp>
 
 #include "bundletrack/eval/sequence_score.hpp"
 #include "bundletrack/io/rgbd_sequence.hpp"
@@ -96,6 +100,71 @@ TEST_CASE("sequence with a folder of masks per object: objects, masks, poses and
   const TempDir single("single_layout");
   synth::writeSyntheticSequence(single.path(), sceneOf(1, 2));
   CHECK(bt::io::RgbdSequence(single.path()).objects().empty());
+  CHECK_THROWS_AS(synth::writeSyntheticSequence(single.path() / "labels", sceneOf(1, 2), bt::io::Layout::YcbInEoat,
+                                                synth::MaskFiles::LabelImages),
+                  bt::InputError);
+}
+
+TEST_CASE("sequence with label images: each object's masks are the renderer's") {
+  const TempDir dir("label_layout");
+  const synth::SyntheticSequenceSettings settings = sceneOf(3, 3);
+  synth::writeSyntheticSequence(dir.path(), settings, bt::io::Layout::YcbInEoat, synth::MaskFiles::LabelImages);
+  const synth::SyntheticScene scene(settings);
+  const bt::io::RgbdSequence sequence(dir.path());
+  REQUIRE(sequence.objects() == std::vector<std::string>{"box", "cylinder", "mug"});
+  CHECK(sequence.objectList() == dir.path() / "labels" / "objects.txt");
+  CHECK(sequence.maskPath(1, "mug") == dir.path() / "labels" / "000001.png");
+  for (int i = 0; i < 3; ++i) {
+    const synth::SyntheticFrame f = scene.frame(i);
+    const std::vector<std::optional<cv::Mat>> masks = sequence.masks(std::size_t(i));
+    REQUIRE(masks.size() == 3);
+    for (std::size_t k = 0; k < 3; ++k) {
+      const cv::Mat& truth = k == 0 ? f.mask : f.others[k - 1].mask;
+      REQUIRE(masks[k]);
+      CHECK(cv::countNonZero(truth) > 0);
+      CHECK(cv::norm(*masks[k], truth, cv::NORM_INF) == 0.0);
+      CHECK(cv::norm(*sequence.mask(std::size_t(i), sequence.objects()[k]), truth, cv::NORM_INF) == 0.0);
+    }
+  }
+  CHECK(!sequence.mask(0));  // no mask of "the" object
+  CHECK(!sequence.read(0).mask.data);
+  CHECK(bt::translationError(sequence.groundTruthPose(2, "mug"), scene.frame(2).others[1].T_cam_obj) < 1e-9);
+  // A frame without its label image: no object has a mask there.
+  std::filesystem::remove(dir.path() / "labels" / "000002.png");
+  for (const std::optional<cv::Mat>& mask : sequence.masks(2)) CHECK(!mask);
+  // A label image of three channels.
+  cv::imwrite((dir.path() / "labels" / "000002.png").string(), cv::Mat(scene.frame(0).mask.size(), CV_8UC3, cv::Scalar::all(1)));
+  CHECK_THROWS_WITH_AS(sequence.masks(2), doctest::Contains("a label image must have one channel of 8 or 16 bits"),
+                       bt::InputError);
+  // Masks in both layouts: which would be meant?
+  std::filesystem::create_directories(dir.path() / "masks" / "box");
+  CHECK_THROWS_WITH_AS(bt::io::RgbdSequence(dir.path()), doctest::Contains("both label images and masks/"), bt::InputError);
+}
+
+TEST_CASE("labels/objects.txt: each line a label and a name, every mistake named with its line") {
+  const auto parse = [](const std::string& text) {
+    std::istringstream in(text);
+    return bt::io::parseLabelNames(in, "objects.txt");
+  };
+  const auto objects = parse("# label object\n1 box\n\n  7 the_mug.2  # comment\n65535 last-one\n");
+  REQUIRE(objects.size() == 3);
+  CHECK(objects[1] == std::pair<int, std::string>{7, "the_mug.2"});
+  CHECK(objects[2].first == 65535);
+  const auto refused = [&](const std::string& text, const char* message) {
+    CHECK_THROWS_WITH_AS(parse(text), doctest::Contains(message), bt::InputError);
+  };
+  refused("", "no object listed");
+  refused("# nothing\n", "no object listed");
+  refused("1 box\n0 cup\n", "line 2: label '0' is not an integer from 1 to 65535");
+  refused("65536 box\n", "line 1: label '65536'");
+  refused("1.5 box\n", "line 1: label '1.5'");
+  refused("box 1\n", "line 1: label 'box'");
+  refused("1\n", "line 1: expected '<label> <name>'");
+  refused("1 box cup\n", "line 1: expected '<label> <name>'");
+  refused("1 box\n1 cup\n", "line 2: label 1 is given twice");
+  refused("1 box\n2 box\n", "line 2: object 'box' is given twice");
+  refused("1 ../x\n", "line 1: object name '../x' may hold only");
+  refused("1 ..\n", "line 1: object name '..'");
 }
 
 TEST_CASE("MultiObjectTracker: each object tracked as alone, bit for bit, one of them starting later") {

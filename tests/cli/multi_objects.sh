@@ -2,7 +2,8 @@
 # bundletrack_track on a sequence of two objects (a folder of masks per object): each object's
 # outputs in OUT/<object>/, a score row per object, --objects choosing one of them (whose poses
 # are those of the run with both), unknown names and --objects on a one-object sequence refused
-# with the reason; a missing mask of one object loses only that object's frame.
+# with the reason; a missing mask of one object loses only that object's frame. The same sequence
+# with label images instead of mask folders gives the same poses.
 # Usage: multi_objects.sh BUNDLETRACK_SYNTH BUNDLETRACK_TRACK WORK_DIR
 set -euo pipefail
 synth=$1 track=$2 work=$3
@@ -34,4 +35,17 @@ if "$track" --sequence "$work/one" --out "$work/y" --objects box 2> "$work/singl
   fail "--objects on a one-object sequence was accepted"
 fi
 grep -q "holds the masks of one object" "$work/single.txt" || fail "single: $(head -1 "$work/single.txt")"
+# Label images (labels/<frame>.png, labels/objects.txt) give each object the masks of its folder,
+# so the same poses.
+"$synth" --out "$work/two_labels" --objects 2 --frames 8 --labels > /dev/null
+[ ! -e "$work/two_labels/masks" ] && [ -s "$work/two_labels/labels/000007.png" ] || fail "--labels wrote no label images"
+"$track" --sequence "$work/two_labels" --out "$work/labels" --quiet --objects box > /dev/null
+diff -r "$work/labels/box/poses" "$work/box/box/poses" > /dev/null || fail "poses from label images differ from those of the mask folders"
+if "$track" --sequence "$work/two_labels" --out "$work/z" --objects plate 2> "$work/unknown_label.txt" > /dev/null; then
+  fail "--objects with an unknown label name was accepted"
+fi
+grep -q "no object 'plate' in .*labels/objects.txt (it has box, cylinder)" "$work/unknown_label.txt" \
+  || fail "unknown label: $(head -1 "$work/unknown_label.txt")"
+if "$synth" --out "$work/w" --labels 2> "$work/labels_one.txt" > /dev/null; then fail "--labels with one object was accepted"; fi
+grep -q -- "--labels needs --objects 2 or 3" "$work/labels_one.txt" || fail "--labels alone: $(cat "$work/labels_one.txt")"
 echo "multi-object command line: ok"

@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # Builds the libFuzzer targets of this folder with clang (address and undefined-behaviour
 # sanitizers on) and runs each for SECONDS on seeds made here: the synthetic generator's files
-# (cam_K.txt, a pose, model points, colour / depth / mask PNGs) and the tracker's printed
-# configuration. A crash, a sanitizer report or an exception other than InputError fails the test
+# (cam_K.txt, a pose, model points, colour / depth / mask PNGs, a label list and image) and the
+# tracker's printed configuration. A crash, a sanitizer report or an exception other than InputError fails the test
 # and leaves the input under WORK_DIR/crashes. Exits 77 (ctest: skipped) without a clang that links
 # -fsanitize=fuzzer.
 # Usage: run_fuzzers.sh BUNDLETRACK_SYNTH BUNDLETRACK_TRACK WORK_DIR SECONDS
@@ -30,6 +30,8 @@ head -50 "$work/seq/model/points.xyz" > "$work/points.xyz" && seed 2 "$work/poin
 seed 3 "$work/seq/rgb/000000.png"
 seed 4 "$work/seq/depth/000000.png"
 seed 5 "$work/seq/masks/000000.png"
+printf '# label object\n1 box\n2 cylinder\n' > "$work/objects.txt" && seed 6 "$work/objects.txt"
+seed 7 "$work/seq/masks/000000.png"
 "$track" --print-config > "$work/seeds/config/defaults.yaml"
 printf 'features:\n  type: orb\n  detect: every_frame\ndepth:\n  min_depth: 0.2\n' > "$work/seeds/config/some.yaml"
 

@@ -12,6 +12,7 @@
 #include "bundletrack/core/se3.hpp"
 #include "bundletrack/io/image_files.hpp"
 #include "bundletrack/io/intrinsics_file.hpp"
+#include "bundletrack/io/label_images.hpp"
 #include "bundletrack/io/point_files.hpp"
 #include "bundletrack/io/pose_files.hpp"
 #include "bundletrack/io/sequence_layouts.hpp"
@@ -34,7 +35,9 @@ struct SequenceSettings {
 ///   model/points.xyz     object points in the object frame (optional)
 /// where <name> is a frame's colour image's file stem. Several objects: masks/ holds a folder per
 /// object instead (masks/<object>/<name>.png; an object starts at its first non-empty mask, and
-/// the first frame needs none), and so do annotated_poses/<object>/ and model/<object>/.
+/// the first frame needs none), and so do annotated_poses/<object>/ and model/<object>/. Or a
+/// label image per frame, labels/<name>.png (8 or 16 bits, one channel: each pixel the label of
+/// the object it shows, 0 none), with labels/objects.txt naming the labels (readLabelNames).
 class RgbdSequence {
  public:
   explicit RgbdSequence(std::filesystem::path root, SequenceSettings settings = {})
@@ -55,7 +58,7 @@ class RgbdSequence {
                                                 std::to_string(image_size_.width) + "x" +
                                                 std::to_string(image_size_.height) + " image");
     checkFieldOfView(camera_, image_size_, root_ / "cam_K.txt");
-    objects_ = objectFolders();
+    objects_ = listObjects();
     if (!objects_.empty()) {
       // The depth unit is judged under the objects visible in the first frame, else over the whole frame.
       cv::Mat visible = cv::Mat::zeros(image_size_, CV_8UC1);
@@ -71,9 +74,13 @@ class RgbdSequence {
     checkDepthScale(rawDepth(0), *first_mask, depth_scale_, depthPath(0), settings_.frame.sensor.max_range);
   }
 
-  /// The objects of a sequence with a folder of masks per object, in name order; empty for a
-  /// sequence of one object (masks/<name>.png), whose functions below take the object "".
+  /// The objects of a sequence with a folder of masks per object (in name order) or with label
+  /// images (in the order of labels/objects.txt); empty for a sequence of one object
+  /// (masks/<name>.png), whose functions below take the object "".
   const std::vector<std::string>& objects() const { return objects_; }
+
+  /// Where the objects are listed: masks/, or labels/objects.txt.
+  std::filesystem::path objectList() const { return labels_.empty() ? root_ / "masks" : labelNamesPath(); }
 
   std::size_t size() const { return frames_.names.size(); }
   const std::vector<std::string>& frameNames() const { return frames_.names; }
@@ -113,16 +120,31 @@ class RgbdSequence {
   /// The mask of frame i (of `object`), or nothing when its file does not exist.
   std::optional<cv::Mat> mask(std::size_t i, const std::string& object = {}) const {
     const auto path = maskPath(i, object);
-    if (!std::filesystem::exists(path)) return std::nullopt;
+    if ((!labels_.empty() && object.empty()) || !std::filesystem::exists(path)) return std::nullopt;
+    if (!labels_.empty()) return labelMask(readLabelImage(path), labelOf(object));
     cv::Mat m = readMask(path);
     requireSize(m, path);
     return m;
+  }
+
+  /// The masks of frame i of every object of objects(), in that order (a label image is read once).
+  std::vector<std::optional<cv::Mat>> masks(std::size_t i) const {
+    std::vector<std::optional<cv::Mat>> all;
+    if (labels_.empty()) {
+      for (const std::string& object : objects_) all.push_back(mask(i, object));
+      return all;
+    }
+    const auto path = maskPath(i);
+    const std::optional<cv::Mat> image = std::filesystem::exists(path) ? std::optional(readLabelImage(path)) : std::nullopt;
+    for (const int label : labels_) all.push_back(image ? std::optional(labelMask(*image, label)) : std::nullopt);
+    return all;
   }
 
   /// Frame i's files (the mask's may not exist).
   std::filesystem::path colorPath(std::size_t i) const { return frames_.color.at(i); }
   std::filesystem::path depthPath(std::size_t i) const { return frames_.depth.at(i); }  ///< empty: none
   std::filesystem::path maskPath(std::size_t i, const std::string& object = {}) const {
+    if (!labels_.empty()) return root_ / "labels" / (frames_.names.at(i) + ".png");
     return folder("masks", object) / (frames_.names.at(i) + ".png");
   }
 
@@ -148,21 +170,46 @@ class RgbdSequence {
   }
   std::filesystem::path modelPath(const std::string& object) const { return folder("model", object) / "points.xyz"; }
 
-  /// The folders of masks/ when the first frame has no mask of its own (masks/<name>.png).
-  std::vector<std::string> objectFolders() const {
+  std::filesystem::path labelNamesPath() const { return root_ / "labels" / "objects.txt"; }
+
+  /// The objects' names: the folders of masks/ when the first frame has no mask of its own
+  /// (masks/<name>.png), or those of labels/objects.txt (their labels into labels_). A sequence
+  /// with both is refused: which one would be meant?
+  std::vector<std::string> listObjects() {
     std::vector<std::string> names;
     std::error_code error;
-    if (std::filesystem::exists(maskPath(0)) || !std::filesystem::is_directory(root_ / "masks", error)) return names;
-    for (const auto& entry : std::filesystem::directory_iterator(root_ / "masks"))
-      if (entry.is_directory()) names.push_back(entry.path().filename().string());
+    if (!std::filesystem::exists(maskPath(0)) && std::filesystem::is_directory(root_ / "masks", error))
+      for (const auto& entry : std::filesystem::directory_iterator(root_ / "masks"))
+        if (entry.is_directory()) names.push_back(entry.path().filename().string());
     std::sort(names.begin(), names.end());
+    if (!std::filesystem::exists(root_ / "labels")) return names;
+    if (std::filesystem::exists(maskPath(0)) || !names.empty())
+      throw InputError(root_ / "labels", "the sequence has both label images and masks/: keep one of them");
+    names.clear();
+    for (const auto& [label, name] : readLabelNames(labelNamesPath())) {
+      labels_.push_back(label);
+      names.push_back(name);
+    }
     return names;
+  }
+
+  int labelOf(const std::string& object) const {
+    const auto at = std::find(objects_.begin(), objects_.end(), object);
+    if (at == objects_.end()) throw InputError(labelNamesPath(), "no object '" + object + "'");
+    return labels_[std::size_t(at - objects_.begin())];
+  }
+
+  cv::Mat readLabelImage(const std::filesystem::path& path) const {
+    cv::Mat labels = labelsFromImage(readImage(path, cv::IMREAD_UNCHANGED), path);
+    requireSize(labels, path);
+    return labels;
   }
 
   std::filesystem::path root_;
   SequenceSettings settings_;
   FrameFiles frames_;
   std::vector<std::string> objects_;
+  std::vector<int> labels_;  ///< of each object, in a sequence with label images (else empty)
   double depth_scale_ = 0.001;
   PinholeCamerad camera_;
   cv::Size image_size_;

@@ -265,6 +265,12 @@ inline std::string tumName(double time) {
   return buffer;
 }
 
+/// How a scene of several objects stores their masks.
+enum class MaskFiles {
+  Folders,  ///< masks/<object>/<name>.png
+  LabelImages,  ///< labels/<name>.png, object k labelled k + 1, named in labels/objects.txt
+};
+
 /// Where object k's masks, poses and model go: masks/, annotated_poses/, model/ themselves for a
 /// single object, their subfolder <object name> when the scene has several.
 inline std::filesystem::path objectFolder(const std::filesystem::path& folder, const SyntheticScene& scene, int k) {
@@ -273,7 +279,8 @@ inline std::filesystem::path objectFolder(const std::filesystem::path& folder, c
 
 /// Writes frame i of `scene` under root: named %06d with depth in millimetres (YCBInEOAT), or by
 /// its timestamps with depth in 1/5000 m (TUM).
-inline void writeFrame(const std::filesystem::path& root, const SyntheticScene& scene, int i, io::Layout layout) {
+inline void writeFrame(const std::filesystem::path& root, const SyntheticScene& scene, int i, io::Layout layout,
+                       MaskFiles mask_files = MaskFiles::Folders) {
   const SyntheticFrame frame = scene.frame(i);
   const bool tum = layout == io::Layout::Tum;
   char buffer[16];
@@ -283,25 +290,39 @@ inline void writeFrame(const std::filesystem::path& root, const SyntheticScene& 
   frame.depth.convertTo(depth_units, CV_16UC1, tum ? 5000.0 : 1000.0);  // rounds to the nearest unit
   detail::writeImage(root / "rgb" / (name + ".png"), frame.color);
   detail::writeImage(root / "depth" / ((tum ? tumName(tumDepthTime(i)) : name) + ".png"), depth_units);
+  cv::Mat labels = cv::Mat::zeros(frame.mask.size(), CV_8UC1);
   for (int k = 0; k < scene.objectCount(); ++k) {
     const ObjectView view = k == 0 ? ObjectView{frame.mask, frame.T_cam_obj} : frame.others[std::size_t(k - 1)];
-    detail::writeImage(objectFolder(root / "masks", scene, k) / (name + ".png"), view.mask);
+    if (mask_files == MaskFiles::LabelImages) labels.setTo(k + 1, view.mask);
+    else detail::writeImage(objectFolder(root / "masks", scene, k) / (name + ".png"), view.mask);
     io::writePose(objectFolder(root / "annotated_poses", scene, k) / (name + ".txt"), view.T_cam_obj);
   }
+  if (mask_files == MaskFiles::LabelImages) detail::writeImage(root / "labels" / (name + ".png"), labels);
 }
 
 /// Writes the sequence in the YCBInEOAT layout (rgb/, depth/ uint16 mm, masks/, annotated_poses/,
 /// cam_K.txt, model/points.xyz), or in the TUM RGB-D layout (the same with rgb.txt and depth.txt
 /// listing timestamped images, depth in 1/5000 m); a scene of several objects has a subfolder per
-/// object in masks/, annotated_poses/ and model/ (objectFolder). Frames are rendered in parallel;
-/// the result depends only on the settings.
+/// object in masks/, annotated_poses/ and model/ (objectFolder), or with MaskFiles::LabelImages
+/// one label image per frame in labels/ instead of masks/. Frames are rendered in parallel; the
+/// result depends only on the settings.
 inline void writeSyntheticSequence(const std::filesystem::path& root, const SyntheticSequenceSettings& settings,
-                                   io::Layout layout = io::Layout::YcbInEoat) {
+                                   io::Layout layout = io::Layout::YcbInEoat, MaskFiles mask_files = MaskFiles::Folders) {
   const SyntheticScene scene(settings);
+  if (mask_files == MaskFiles::LabelImages && scene.objectCount() == 1)
+    throw InputError(root, "label images are for scenes of several objects");
   for (const char* dir : {"rgb", "depth"}) std::filesystem::create_directories(root / dir);
   for (int k = 0; k < scene.objectCount(); ++k)
     for (const char* dir : {"masks", "annotated_poses", "model"})
-      std::filesystem::create_directories(objectFolder(root / dir, scene, k));
+      if (std::string(dir) != "masks" || mask_files == MaskFiles::Folders)
+        std::filesystem::create_directories(objectFolder(root / dir, scene, k));
+  if (mask_files == MaskFiles::LabelImages) {
+    std::filesystem::create_directories(root / "labels");
+    std::ofstream names(root / "labels" / "objects.txt");
+    names << "# label object\n";
+    for (int k = 0; k < scene.objectCount(); ++k) names << k + 1 << ' ' << scene.objectName(k) << '\n';
+    if (!names) throw InputError(root / "labels" / "objects.txt", "cannot write file");
+  }
   if (layout == io::Layout::Tum) {
     std::ofstream rgb(root / "rgb.txt"), depth(root / "depth.txt");
     rgb << "# color images\n# timestamp filename\n";
@@ -326,7 +347,7 @@ inline void writeSyntheticSequence(const std::filesystem::path& root, const Synt
   std::exception_ptr first_error;
   cv::parallel_for_(cv::Range(0, settings.frames), [&](const cv::Range& range) {
     try {
-      for (int i = range.start; i < range.end; ++i) writeFrame(root, scene, i, layout);
+      for (int i = range.start; i < range.end; ++i) writeFrame(root, scene, i, layout, mask_files);
     } catch (...) {
       const std::lock_guard lock(error_mutex);
       if (!first_error) first_error = std::current_exception();
