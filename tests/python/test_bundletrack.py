@@ -289,3 +289,92 @@ def test_metrics_bad_arguments():
         bt.score(np.zeros((3, 3)), [np.eye(4)], [np.diag([1.0, 1, -1, 1])])
     with pytest.raises(ValueError, match="sequence directory not found"):
         bt.Sequence("/nonexistent/sequence")
+
+
+@pytest.fixture(scope="session")
+def two(tmp_path_factory):
+    """Two synthetic objects (a box and a can passing in front of each other), in mask folders
+    and in label images, and the CLI's poses of each."""
+    root = tmp_path_factory.mktemp("two")
+    run("bundletrack_synth", "--out", root / "seq", "--frames", FRAMES, "--objects", 2)
+    run("bundletrack_synth", "--out", root / "labels", "--frames", FRAMES, "--objects", 2, "--labels")
+    run("bundletrack_track", "--sequence", root / "seq", "--out", root / "cli", "--quiet")
+    return root
+
+
+def track_objects(seq):
+    """Each object of a sequence of several through MultiTracker, from files read by OpenCV, each
+    starting at its annotated pose, as bundletrack_track does."""
+    sequence = bt.Sequence(str(seq))
+    tracker = bt.MultiTracker(sequence.objects, sequence.K)
+    poses = {name: [] for name in sequence.objects}
+    for i in range(len(sequence)):
+        rgb, depth, _ = files(seq, i)
+        masks = {name: cv2.imread(str(seq / "masks" / name / f"{i:06d}.png"), cv2.IMREAD_UNCHANGED)
+                 for name in sequence.objects}
+        starts = {name: sequence.ground_truth(i, name) for name in sequence.objects}
+        for name, result in tracker.track(rgb, depth, masks, starts).items():
+            assert result is not None  # both objects are in view from the first frame
+            poses[name].append(result.pose)
+    assert tracker.started == {name: True for name in sequence.objects}
+    return poses
+
+
+def test_multi_tracker_gives_the_cli_poses_of_each_object(two):
+    poses = track_objects(two / "seq")
+    assert sorted(poses) == ["box", "cylinder"]
+    for name, estimates in poses.items():
+        assert largest_difference(estimates, cli_poses(two / "cli", name)) <= 1e-9
+        truth = [np.loadtxt(two / "seq" / "annotated_poses" / name / f"{i:06d}.txt") for i in range(FRAMES)]
+        model = np.loadtxt(two / "seq" / "model" / name / "points.xyz")
+        assert bt.score(model, truth, estimates)["adds_auc"] > 95
+
+
+def test_sequence_masks_of_folders_and_label_images_are_the_files(two, box):
+    folders, labels = bt.Sequence(str(two / "seq")), bt.Sequence(str(two / "labels"))
+    assert folders.objects == labels.objects == ["box", "cylinder"]
+    for i in (0, FRAMES - 1):
+        label_image = cv2.imread(str(two / "labels" / "labels" / f"{i:06d}.png"), cv2.IMREAD_UNCHANGED)
+        for label, name in enumerate(folders.objects, start=1):
+            mask = cv2.imread(str(two / "seq" / "masks" / name / f"{i:06d}.png"), cv2.IMREAD_UNCHANGED)
+            assert np.array_equal(folders.masks(i)[name], mask)
+            assert np.array_equal(labels.masks(i)[name], np.where(label_image == label, 255, 0).astype(np.uint8))
+            assert np.array_equal(labels.masks(i)[name], mask)
+    assert folders.model_points("cylinder").shape[1] == 3
+    assert bt.Sequence(str(box / "seq")).objects == []
+    with pytest.raises(ValueError, match="a sequence of one object"):
+        bt.Sequence(str(box / "seq")).masks(0)
+
+
+def test_multi_tracker_bad_arguments_raise(two):
+    seq = two / "seq"
+    sequence = bt.Sequence(str(seq))
+    rgb, depth, _ = files(seq, 0)
+    masks = sequence.masks(0)
+    with pytest.raises(ValueError, match="objects: name at least one object"):
+        bt.MultiTracker([], sequence.K)
+    with pytest.raises(ValueError, match="objects: 'box' is named twice"):
+        bt.MultiTracker(["box", "box"], sequence.K)
+    with pytest.raises(ValueError, match="K: expected a 3x3 matrix"):
+        bt.MultiTracker(["box"], np.eye(2))
+    tracker = bt.MultiTracker(sequence.objects, sequence.K)
+    with pytest.raises(TypeError, match="masks: expected a dict from object names"):
+        tracker.track(rgb, depth, [masks["box"]])
+    with pytest.raises(ValueError, match=r"masks: no object 'plate' \(objects: box, cylinder\)"):
+        tracker.track(rgb, depth, {"plate": masks["box"]})
+    with pytest.raises(ValueError, match=r"poses\['box'\]: rotation block is not a rotation"):
+        tracker.track(rgb, depth, masks, {"box": np.diag([2.0, 1, 1, 1])})
+    with pytest.raises(ValueError, match=r"mask"):
+        tracker.track(rgb, depth, {"box": masks["box"][:10]})
+    results = tracker.track(rgb, depth, {"box": masks["box"]})  # the can sits the first frame out
+    assert results["box"].tracked and results["cylinder"] is None
+    assert tracker.started == {"box": True, "cylinder": False}
+    with pytest.raises(ValueError, match="rgb: image is 640x240"):
+        tracker.track(rgb[:240], depth[:240], {})
+    propagated = bt.MultiTracker(sequence.objects, sequence.K, {"masks": {"source": "propagated"}})
+    propagated.track(rgb, depth, masks)
+    with pytest.raises(ValueError, match=r"masks\['box'\]: masks.source is 'propagated'"):
+        propagated.track(rgb, depth, masks)
+    with pytest.raises(ValueError, match="no object 'plate'"):
+        tracker.object_model("plate")
+    assert tracker.object_model("box")["points"].shape[1] == 3

@@ -8,6 +8,7 @@
 #include <pybind11/stl.h>
 #include <pybind11/stl/filesystem.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <memory>
@@ -23,6 +24,7 @@
 #include "bundletrack/io/model_file.hpp"
 #include "bundletrack/io/rgbd_sequence.hpp"
 #include "bundletrack/runtime/make_tracker.hpp"
+#include "bundletrack/tracking/multi_object_tracker.hpp"
 
 namespace py = pybind11;
 namespace bt = bundletrack;
@@ -200,6 +202,28 @@ Result resultOf(const bt::TrackResult& r) {
           timings, r.mask.empty() ? py::object(py::none()) : py::object(arrayOf<std::uint8_t>(r.mask))};
 }
 
+/// The object model's arrays: points and normals (Nx3 float32, object frame, metres) and colours
+/// (Nx3 uint8 BGR).
+py::dict modelArrays(const std::vector<bt::ModelPoint>& model) {
+  py::array_t<float> points({py::ssize_t(model.size()), py::ssize_t(3)}), normals({py::ssize_t(model.size()), py::ssize_t(3)});
+  py::array_t<std::uint8_t> colors({py::ssize_t(model.size()), py::ssize_t(3)});
+  auto p = points.mutable_unchecked<2>();
+  auto n = normals.mutable_unchecked<2>();
+  auto c = colors.mutable_unchecked<2>();
+  for (py::ssize_t k = 0; k < py::ssize_t(model.size()); ++k)
+    for (py::ssize_t d = 0; d < 3; ++d) {
+      p(k, d) = model[std::size_t(k)].position[d];
+      n(k, d) = model[std::size_t(k)].normal[d];
+      c(k, d) = model[std::size_t(k)].color[int(d)];
+    }
+  py::dict out;
+  out["points"] = points, out["normals"] = normals, out["colors"] = colors;
+  return out;
+}
+
+/// Metres per unit of uint16 depth arrays: depth.scale, or millimetres when it is 0 (the layout's).
+double depthScaleOf(const bt::Config& config) { return config.sequence.depth_scale > 0.0 ? config.sequence.depth_scale : 0.001; }
+
 /// The tracker of a configuration, made at initialize() from the first frame's intrinsics.
 class PyTracker {
  public:
@@ -212,11 +236,11 @@ class PyTracker {
     const bt::PinholeCamerad camera = bt::io::intrinsicsFromNumbers(matrixArgument(K, 3, 3, "K"), "K");
     bt::io::checkFieldOfView(camera, size, "K");
     py::array depth_owner;
-    const cv::Mat metres = depthArgument(depth, arrayDepthScale(), size, depth_owner);
+    const cv::Mat metres = depthArgument(depth, depthScaleOf(config_), size, depth_owner);
     if (mask.is_none()) throw bt::InputError("mask", "the first frame needs the object's mask");
     const cv::Mat object = maskArgument(mask, size);
     if (cv::countNonZero(object) == 0) throw bt::InputError("mask", "the first frame's object mask is empty");
-    bt::io::checkDepthScale(metres, object, arrayDepthScale(), "depth", config_.sequence.frame.sensor.max_range);
+    bt::io::checkDepthScale(metres, object, depthScaleOf(config_), "depth", config_.sequence.frame.sensor.max_range);
     const bt::SE3d T_cam_obj = pose.is_none() ? bt::SE3d() : poseArgument(pose, "pose");
     std::unique_ptr<bt::AnyTracker> tracker = bt::makeTracker(config_, camera.cast<float>());
     bt::TrackResult result;
@@ -240,7 +264,7 @@ class PyTracker {
                                       " but the first frame's is " + std::to_string(size_.width) + "x" +
                                       std::to_string(size_.height));
     py::array depth_owner;
-    const cv::Mat metres = depthArgument(depth, arrayDepthScale(), size_, depth_owner);
+    const cv::Mat metres = depthArgument(depth, depthScaleOf(config_), size_, depth_owner);
     const bool propagated = config_.masks == "propagated";
     if (propagated && !mask.is_none())
       throw bt::InputError("mask", "masks.source is 'propagated': the tracker follows the first mask, pass none");
@@ -260,24 +284,9 @@ class PyTracker {
     return resultOf(result);
   }
 
-  /// The object's model fused from the keyframes: points and normals (Nx3 float32, object
-  /// frame, metres) and colours (Nx3 uint8 BGR).
+  /// The object's model fused from the keyframes (modelArrays).
   py::dict objectModel() const {
-    const std::vector<bt::ModelPoint> model = tracker_ ? tracker_->objectModel() : std::vector<bt::ModelPoint>();
-    py::array_t<float> points({py::ssize_t(model.size()), py::ssize_t(3)}), normals({py::ssize_t(model.size()), py::ssize_t(3)});
-    py::array_t<std::uint8_t> colors({py::ssize_t(model.size()), py::ssize_t(3)});
-    auto p = points.mutable_unchecked<2>();
-    auto n = normals.mutable_unchecked<2>();
-    auto c = colors.mutable_unchecked<2>();
-    for (py::ssize_t k = 0; k < py::ssize_t(model.size()); ++k)
-      for (py::ssize_t d = 0; d < 3; ++d) {
-        p(k, d) = model[std::size_t(k)].position[d];
-        n(k, d) = model[std::size_t(k)].normal[d];
-        c(k, d) = model[std::size_t(k)].color[int(d)];
-      }
-    py::dict out;
-    out["points"] = points, out["normals"] = normals, out["colors"] = colors;
-    return out;
+    return modelArrays(tracker_ ? tracker_->objectModel() : std::vector<bt::ModelPoint>());
   }
 
   void writeModel(const std::filesystem::path& path) const {
@@ -290,9 +299,6 @@ class PyTracker {
   std::string configYaml() const { return bt::printConfig(config_); }
 
  private:
-  /// Metres per unit of uint16 depth arrays: depth.scale, or millimetres when it is 0 (the layout's).
-  double arrayDepthScale() const { return config_.sequence.depth_scale > 0.0 ? config_.sequence.depth_scale : 0.001; }
-
   bt::Config config_;
   std::unique_ptr<bt::AnyTracker> tracker_;
   bt::PinholeCamerad camera_{};
@@ -300,7 +306,122 @@ class PyTracker {
   int frames_ = 0;
 };
 
-/// A YCBInEOAT-layout sequence (README: rgb/, depth/, masks/, cam_K.txt, annotated_poses/, model/).
+/// Several objects in one camera (MultiObjectTracker): each frame is read and preprocessed once,
+/// over the union of the regions the objects' trackers ask for, and each object has a tracker of
+/// its own that starts with the first frame bringing a non-empty mask of it.
+class PyMultiTracker {
+ public:
+  PyMultiTracker(std::vector<std::string> objects, const py::handle& K, const py::object& config)
+      : config_(configArgument(config)), objects_(std::move(objects)),
+        camera_(bt::io::intrinsicsFromNumbers(matrixArgument(K, 3, 3, "K"), "K")) {
+    if (objects_.empty()) throw bt::InputError("objects", "name at least one object");
+    for (std::size_t k = 0; k < objects_.size(); ++k)
+      if (std::find(objects_.begin(), objects_.begin() + std::ptrdiff_t(k), objects_[k]) != objects_.begin() + std::ptrdiff_t(k))
+        throw bt::InputError("objects", "'" + objects_[k] + "' is named twice");
+    tracker_.emplace(objects_.size(), [&] { return bt::makeTracker(config_, camera_.cast<float>()); });
+  }
+
+  /// One frame for every object: masks maps names to HxW masks (a name left out or None: that
+  /// object sits the frame out, or, with masks.source 'propagated' once it has started, follows
+  /// its own masks); poses maps names to the 4x4 T_cam_obj an object starts at (identity).
+  py::dict track(const py::handle& rgb, const py::handle& depth, const py::handle& masks, const py::handle& poses) {
+    MatView color = colorArgument(rgb);
+    if (frames_ == 0) {
+      bt::io::checkFieldOfView(camera_, color.mat.size(), "K");
+      size_ = color.mat.size();
+    } else if (color.mat.size() != size_) {
+      throw bt::InputError("rgb", "image is " + std::to_string(color.mat.cols) + "x" + std::to_string(color.mat.rows) +
+                                      " but the first frame's is " + std::to_string(size_.width) + "x" +
+                                      std::to_string(size_.height));
+    }
+    py::array depth_owner;
+    const cv::Mat metres = depthArgument(depth, depthScaleOf(config_), size_, depth_owner);
+    const py::dict given = namedArgument(masks, "masks");
+    const py::dict starts = namedArgument(poses, "poses");
+    const bool propagated = config_.masks == "propagated";
+    bt::MultiObjectTracker::ObjectMasks object_masks(objects_.size());
+    std::vector<bt::SE3d> start_poses(objects_.size());
+    cv::Mat seen = cv::Mat::zeros(size_, CV_8UC1);
+    for (std::size_t k = 0; k < objects_.size(); ++k) {
+      const std::string& name = objects_[k];
+      const std::string mask_name = "masks['" + name + "']", pose_name = "poses['" + name + "']";
+      const py::object mask = given.contains(name) ? py::object(given[name.c_str()]) : py::object(py::none());
+      if (propagated && tracker_->started(k)) {
+        if (!mask.is_none())
+          throw bt::InputError(mask_name, "masks.source is 'propagated': a started object follows its own masks, pass none");
+        object_masks[k] = cv::Mat();
+      } else if (!mask.is_none()) {
+        object_masks[k] = maskArgument(mask, size_);
+        seen |= *object_masks[k];
+      }
+      if (starts.contains(name)) start_poses[k] = poseArgument(starts[name.c_str()], pose_name.c_str());
+    }
+    if (frames_ == 0) {
+      if (cv::countNonZero(seen) == 0) seen.setTo(255);
+      bt::io::checkDepthScale(metres, seen, depthScaleOf(config_), "depth", config_.sequence.frame.sensor.max_range);
+    }
+    std::vector<std::optional<bt::TrackResult>> results;
+    {
+      py::gil_scoped_release unlocked;
+      const cv::Rect region = tracker_->regionOfInterest(size_, object_masks);
+      const bt::RgbdFrame frame = bt::makeFrame(std::to_string(frames_), color.mat, metres, cv::Mat(), camera_.cast<float>(),
+                                                config_.sequence.frame, region);
+      results = tracker_->track(frame, object_masks, start_poses);
+    }
+    ++frames_;
+    py::dict out;
+    for (std::size_t k = 0; k < objects_.size(); ++k)
+      out[objects_[k].c_str()] = results[k] ? py::cast(resultOf(*results[k])) : py::object(py::none());
+    return out;
+  }
+
+  py::dict objectModel(const std::string& name) const { return modelArrays(tracker_->tracker(indexOf(name)).objectModel()); }
+  const std::vector<std::string>& objects() const { return objects_; }
+  int frames() const { return frames_; }
+  py::dict started() const {
+    py::dict out;
+    for (std::size_t k = 0; k < objects_.size(); ++k) out[objects_[k].c_str()] = tracker_->started(k);
+    return out;
+  }
+
+ private:
+  std::size_t indexOf(const std::string& name) const {
+    const auto at = std::find(objects_.begin(), objects_.end(), name);
+    if (at == objects_.end()) throw bt::InputError("object", "no object '" + name + "' (objects: " + objectList() + ")");
+    return std::size_t(at - objects_.begin());
+  }
+
+  std::string objectList() const {
+    std::string list;
+    for (const std::string& name : objects_) list += (list.empty() ? "" : ", ") + name;
+    return list;
+  }
+
+  /// A dict keyed by the tracker's object names (None: empty).
+  py::dict namedArgument(const py::handle& value, const char* what) const {
+    if (value.is_none()) return py::dict();
+    if (!py::isinstance<py::dict>(value))
+      throw py::type_error(std::string(what) + ": expected a dict from object names to arrays, or None");
+    const py::dict named = value.cast<py::dict>();
+    for (const auto& [key, item] : named) {
+      if (!py::isinstance<py::str>(key)) throw py::type_error(std::string(what) + ": keys must be object names (str)");
+      const std::string name = key.cast<std::string>();
+      if (std::find(objects_.begin(), objects_.end(), name) == objects_.end())
+        throw bt::InputError(what, "no object '" + name + "' (objects: " + objectList() + ")");
+    }
+    return named;
+  }
+
+  bt::Config config_;
+  std::vector<std::string> objects_;
+  bt::PinholeCamerad camera_;
+  std::optional<bt::MultiObjectTracker> tracker_;
+  cv::Size size_;
+  int frames_ = 0;
+};
+
+
+/// A sequence folder (README: rgb/, depth/ or rgb.txt, depth.txt; masks/ or labels/, cam_K.txt, annotated_poses/, model/).
 class PySequence {
  public:
   PySequence(const std::filesystem::path& path, const py::object& config)
@@ -322,11 +443,25 @@ class PySequence {
                           raw.mask.empty() ? py::object(py::none()) : py::object(arrayOf<std::uint8_t>(raw.mask)));
   }
 
+  /// Frame i's masks of every object (dict: name -> HxW uint8 or None), for several objects.
+  py::dict masks(std::size_t i) const {
+    if (sequence_.objects().empty())
+      throw bt::InputError(sequence_.root() / "masks", "a sequence of one object (masks/<frame>.png): use read()");
+    const std::vector<std::optional<cv::Mat>> all = sequence_.masks(index(i));
+    py::dict out;
+    for (std::size_t k = 0; k < all.size(); ++k)
+      out[sequence_.objects()[k].c_str()] = all[k] ? py::object(arrayOf<std::uint8_t>(*all[k])) : py::object(py::none());
+    return out;
+  }
+
+  const std::vector<std::string>& objects() const { return sequence_.objects(); }
   bool hasGroundTruth() const { return sequence_.hasGroundTruth(); }
-  Matrix4 groundTruth(std::size_t i) const { return matrixOf(sequence_.groundTruthPose(index(i))); }
+  Matrix4 groundTruth(std::size_t i, const std::string& object) const {
+    return matrixOf(sequence_.groundTruthPose(index(i), object));
+  }
   bool hasModel() const { return sequence_.hasModel(); }
-  Eigen::Matrix<float, Eigen::Dynamic, 3, Eigen::RowMajor> modelPoints() const {
-    const std::vector<Eigen::Vector3f> points = sequence_.modelPoints();
+  Eigen::Matrix<float, Eigen::Dynamic, 3, Eigen::RowMajor> modelPoints(const std::string& object) const {
+    const std::vector<Eigen::Vector3f> points = sequence_.modelPoints(object);
     Eigen::Matrix<float, Eigen::Dynamic, 3, Eigen::RowMajor> out(points.size(), 3);
     for (std::size_t k = 0; k < points.size(); ++k) out.row(Eigen::Index(k)) = points[k].transpose();
     return out;
@@ -423,16 +558,38 @@ PYBIND11_MODULE(bundletrack, m) {
       .def_property_readonly("keyframes", &PyTracker::keyframes, "keyframes in memory")
       .def_property_readonly("config_yaml", &PyTracker::configYaml, "the effective configuration as YAML");
 
-  py::class_<PySequence>(m, "Sequence", "Sequence(path, config=None): a YCBInEOAT-layout sequence (README)")
+  py::class_<PySequence>(m, "Sequence", "Sequence(path, config=None): a sequence folder, YCBInEOAT or TUM RGB-D layout (README)")
       .def(py::init<const std::filesystem::path&, const py::object&>(), py::arg("path"), py::arg("config") = py::none())
       .def("__len__", &PySequence::size)
       .def_property_readonly("names", &PySequence::names)
       .def_property_readonly("K", &PySequence::intrinsics, "3x3 intrinsics (cam_K.txt)")
       .def("read", &PySequence::read, py::arg("i"), "(rgb uint8 BGR, depth float32 metres, mask uint8 or None) of frame i")
+      .def_property_readonly("objects", &PySequence::objects,
+                             "names of the objects of a sequence of several (masks/<object>/ or labels/objects.txt); "
+                             "[] for one object")
+      .def("masks", &PySequence::masks, py::arg("i"), "{object: HxW uint8 mask or None} of frame i (several objects)")
       .def_property_readonly("has_ground_truth", &PySequence::hasGroundTruth)
-      .def("ground_truth", &PySequence::groundTruth, py::arg("i"), "4x4 annotated T_cam_obj of frame i")
+      .def("ground_truth", &PySequence::groundTruth, py::arg("i"), py::arg("object") = "",
+           "4x4 annotated T_cam_obj of frame i (of `object` among several)")
       .def_property_readonly("has_model", &PySequence::hasModel)
-      .def("model_points", &PySequence::modelPoints, "Nx3 float32 object points (model/points.xyz)");
+      .def("model_points", &PySequence::modelPoints, py::arg("object") = "",
+           "Nx3 float32 object points (model/points.xyz, model/<object>/points.xyz)");
+
+  py::class_<PyMultiTracker>(m, "MultiTracker",
+                             "MultiTracker(objects, K, config=None): several objects in one camera, each with a tracker "
+                             "of its own (config as for Tracker), every frame preprocessed once for all of them")
+      .def(py::init<std::vector<std::string>, const py::handle&, const py::object&>(), py::arg("objects"), py::arg("K"),
+           py::arg("config") = py::none())
+      .def("track", &PyMultiTracker::track, py::arg("rgb"), py::arg("depth"), py::arg("masks"),
+           py::arg("poses") = py::none(),
+           "One frame for every object: rgb and depth as for Tracker, masks {name: HxW mask} (a name left out or "
+           "None sits the frame out, or follows its own masks once started with masks.source 'propagated'), poses "
+           "{name: 4x4 T_cam_obj} where an object starts (identity). An object starts with its first non-empty "
+           "mask. Returns {name: Result, or None while it has not started or sits the frame out}")
+      .def("object_model", &PyMultiTracker::objectModel, py::arg("object"), "the object's model, as Tracker.object_model")
+      .def_property_readonly("objects", &PyMultiTracker::objects)
+      .def_property_readonly("started", &PyMultiTracker::started, "{name: whether the object has started}")
+      .def_property_readonly("frames", &PyMultiTracker::frames, "frames seen so far");
 
   m.def("score", &score, py::arg("model"), py::arg("truth"), py::arg("estimates"),
         "ADD / ADD-S AUC (0-10 cm, x100), 5deg5cm and IoU25 (%), mean errors, over the frames; an estimate of "
