@@ -421,7 +421,8 @@ class PyMultiTracker {
 };
 
 
-/// A sequence folder (README: rgb/, depth/ or rgb.txt, depth.txt; masks/ or labels/, cam_K.txt, annotated_poses/, model/).
+/// A sequence folder (README: rgb/, depth/ or rgb.txt, depth.txt; masks/ or labels/; cam_K.txt,
+/// annotated_poses/, model/).
 class PySequence {
  public:
   PySequence(const std::filesystem::path& path, const py::object& config)
