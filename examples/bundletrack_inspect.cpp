@@ -61,6 +61,7 @@ int main(int argc, char** argv) {
 
   try {
     const bt::io::RgbdSequence sequence(sequence_dir, settings);
+    for (const std::string& caution : sequence.warnings()) std::printf("warning    %s\n", caution.c_str());
     const auto& K = sequence.camera();
     std::printf("sequence   %s\nframes     %zu (%s .. %s), %dx%d\nintrinsics fx %.2f fy %.2f cx %.2f cy %.2f\n",
                 sequence_dir.c_str(), sequence.size(), sequence.frameNames().front().c_str(),

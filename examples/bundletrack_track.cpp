@@ -617,6 +617,7 @@ int main(int argc, char** argv) {
     if (options.sequence.empty() || options.out.empty()) fail("--sequence and --out are required");
     prepareOutput(options.out, {});
     const bt::io::RgbdSequence sequence(options.sequence, config.sequence);
+    for (const std::string& caution : sequence.warnings()) std::cerr << "warning: " << caution << '\n';
     const std::vector<std::string> objects = chosenObjects(sequence, options.objects);
     std::vector<fs::path> folders = {"poses"};
     if (config.masks == "propagated") folders.push_back("masks");

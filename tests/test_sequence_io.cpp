@@ -130,9 +130,34 @@ TEST_CASE("bad input raises InputError naming the file and the problem") {
     bt::io::SequenceSettings settings;
     settings.depth_scale = 0.0001;
     CHECK(bt::io::RgbdSequence(root, settings).frame(0).depth.at<float>(30, 40) == doctest::Approx(0.8f));
+    CHECK(bt::io::RgbdSequence(root, settings).warnings().empty());
     settings.depth_scale = 0.0;
     settings.frame.sensor = bt::DepthNoise::activeStereo();  // specified to 10 m: 10 m is within twice that
     CHECK(bt::io::RgbdSequence(root, settings).frame(0).depth.at<float>(30, 40) == doctest::Approx(8.0f));
+    CHECK(bt::io::RgbdSequence(root, settings).warnings().empty());
+  }
+  SUBCASE("depth in 0.2 mm read as millimetres") {
+    // The wall at 1.2 m and the object at 1 m read as 6 m and 5 m: beyond a Kinect's 4 m but
+    // within twice that, so a caution naming the likely unit, not an error.
+    for (const char* name : {"1", "2", "10"}) {
+      cv::Mat depth(60, 80, CV_16UC1, cv::Scalar(6000));
+      depth(cv::Rect(30, 20, 20, 20)).setTo(5000);
+      cv::imwrite((root / "depth" / (std::string(name) + ".png")).string(), depth);
+    }
+    const bt::io::RgbdSequence sequence(root);
+    REQUIRE(sequence.warnings().size() == 1);
+    CHECK(sequence.warnings()[0].find("1.png: median depth of the whole first frame is 6.000000 m") != std::string::npos);
+    CHECK(sequence.warnings()[0].find("more than the 4.00 m that the sensor (sensor.model) is specified for") !=
+          std::string::npos);
+    CHECK(sequence.warnings()[0].find("0.2 mm or TUM RGB-D's 1/5000: 0.0002") != std::string::npos);
+    bt::io::SequenceSettings settings;
+    settings.depth_scale = 0.0002;
+    CHECK(bt::io::RgbdSequence(root, settings).warnings().empty());
+    settings.depth_scale = 0.0;
+    settings.frame.sensor = bt::DepthNoise::timeOfFlight();  // specified to 5.46 m
+    CHECK(bt::io::RgbdSequence(root, settings).warnings().size() == 1);
+    settings.frame.sensor = bt::DepthNoise::activeStereo();  // specified to 10 m
+    CHECK(bt::io::RgbdSequence(root, settings).warnings().empty());
   }
   SUBCASE("missing first mask") {
     fs::remove(root / "masks" / "1.png");

@@ -378,3 +378,15 @@ def test_multi_tracker_bad_arguments_raise(two):
     with pytest.raises(ValueError, match="no object 'plate'"):
         tracker.object_model("plate")
     assert tracker.object_model("box")["points"].shape[1] == 3
+
+
+def test_depth_beyond_the_sensors_range_warns_naming_the_unit(box):
+    # 0.2 mm units read as millimetres: a wall at 1.2 m and the object at 1 m seem 6 m and 5 m away.
+    sequence = bt.Sequence(str(box / "seq"))
+    rgb, _, mask = files(box / "seq", 0)
+    depth = np.full(mask.shape, 6000, np.uint16)
+    depth[mask > 0] = 5000
+    with pytest.warns(UserWarning, match=r"more than the 4.00 m that the sensor .* 0\.0002"):
+        bt.Tracker().initialize(rgb, depth, mask, sequence.K)
+    with pytest.warns(UserWarning, match=r"more than the 4.00 m"):
+        bt.MultiTracker(["box"], sequence.K).track(rgb, depth, {"box": mask})

@@ -202,6 +202,11 @@ Result resultOf(const bt::TrackResult& r) {
           timings, r.mask.empty() ? py::object(py::none()) : py::object(arrayOf<std::uint8_t>(r.mask))};
 }
 
+/// Shows a caution of the readers (e.g. checkDepthScale's) as a Python UserWarning.
+void warn(const std::string& caution) {
+  if (!caution.empty() && PyErr_WarnEx(PyExc_UserWarning, caution.c_str(), 1) != 0) throw py::error_already_set();
+}
+
 /// The object model's arrays: points and normals (Nx3 float32, object frame, metres) and colours
 /// (Nx3 uint8 BGR).
 py::dict modelArrays(const std::vector<bt::ModelPoint>& model) {
@@ -240,7 +245,7 @@ class PyTracker {
     if (mask.is_none()) throw bt::InputError("mask", "the first frame needs the object's mask");
     const cv::Mat object = maskArgument(mask, size);
     if (cv::countNonZero(object) == 0) throw bt::InputError("mask", "the first frame's object mask is empty");
-    bt::io::checkDepthScale(metres, object, depthScaleOf(config_), "depth", config_.sequence.frame.sensor.max_range);
+    warn(bt::io::checkDepthScale(metres, object, depthScaleOf(config_), "depth", config_.sequence.frame.sensor.max_range));
     const bt::SE3d T_cam_obj = pose.is_none() ? bt::SE3d() : poseArgument(pose, "pose");
     std::unique_ptr<bt::AnyTracker> tracker = bt::makeTracker(config_, camera.cast<float>());
     bt::TrackResult result;
@@ -358,7 +363,7 @@ class PyMultiTracker {
     }
     if (frames_ == 0) {
       if (cv::countNonZero(seen) == 0) seen.setTo(255);
-      bt::io::checkDepthScale(metres, seen, depthScaleOf(config_), "depth", config_.sequence.frame.sensor.max_range);
+      warn(bt::io::checkDepthScale(metres, seen, depthScaleOf(config_), "depth", config_.sequence.frame.sensor.max_range));
     }
     std::vector<std::optional<bt::TrackResult>> results;
     {
@@ -426,7 +431,9 @@ class PyMultiTracker {
 class PySequence {
  public:
   PySequence(const std::filesystem::path& path, const py::object& config)
-      : sequence_(path, configArgument(config).sequence) {}
+      : sequence_(path, configArgument(config).sequence) {
+    for (const std::string& caution : sequence_.warnings()) warn(caution);
+  }
 
   std::size_t size() const { return sequence_.size(); }
   const std::vector<std::string>& names() const { return sequence_.frameNames(); }

@@ -97,9 +97,13 @@ inline cv::Mat depthFromImage(const cv::Mat& raw, double scale, const std::files
 /// `max_range`, the farthest depth the sensor's specification covers (DepthNoise::max_range;
 /// 0: not checked). Twice, because sensors report beyond their specified range and a room's far
 /// wall may lie there; an object 1 m away read in 0.1 mm units with millimetres' 0.001 seems 10 m
-/// away. `scale` is the unit the depth was read with, `source` names the depth in the error.
-inline void checkDepthScale(const cv::Mat& depth, const cv::Mat& mask, double scale, const std::filesystem::path& source,
-                            double max_range = 0.0) {
+/// away. A frame median beyond max_range itself but within twice it is returned as a caution (the
+/// caller shows it; empty: none): 0.2 mm units read as millimetres put a scene whose median is
+/// 0.8-1.6 m there, and the sensor's noise is unspecified there anyway. Scenes nearer than that
+/// read five times too far cannot be told from real far ones. `scale` is the unit the depth was
+/// read with, `source` names the depth in the messages.
+[[nodiscard]] inline std::string checkDepthScale(const cv::Mat& depth, const cv::Mat& mask, double scale,
+                                                 const std::filesystem::path& source, double max_range = 0.0) {
   const auto median = [&](bool whole_frame) {
     std::vector<float> values;
     for (int v = 0; v < depth.rows; ++v)
@@ -119,16 +123,20 @@ inline void checkDepthScale(const cv::Mat& depth, const cv::Mat& mask, double sc
   if (object > 20.0)
     throw InputError(source, stated + ": farther than any RGB-D sensor measures; the depth scale is probably too large"
                                       " (images in millimetres need 0.001, not 1)");
-  if (max_range <= 0.0) return;
+  if (max_range <= 0.0) return {};
   const double frame = median(true);
-  if (frame > 2.0 * max_range) {
-    char range[32];
-    std::snprintf(range, sizeof(range), "%.2f", max_range);
-    throw InputError(source, "median depth of the whole first frame is " + std::to_string(frame) + " m" + with_scale +
-                                 ", more than twice the " + range + " m that the sensor (sensor.model) is specified "
-                                 "for: the depth scale is probably too large (images in 0.1 mm need 0.0001, TUM "
-                                 "RGB-D's 1/5000 0.0002) or sensor.model names another sensor");
-  }
+  if (frame <= max_range) return {};
+  char range[32];
+  std::snprintf(range, sizeof(range), "%.2f", max_range);
+  const std::string beyond = "median depth of the whole first frame is " + std::to_string(frame) + " m" + with_scale +
+                             ", more than " + (frame > 2.0 * max_range ? "twice " : "") + "the " + range +
+                             " m that the sensor (sensor.model) is specified for: ";
+  if (frame > 2.0 * max_range)
+    throw InputError(source, beyond + "the depth scale is probably too large (images in 0.1 mm need 0.0001, TUM "
+                                      "RGB-D's 1/5000 0.0002) or sensor.model names another sensor");
+  return source.string() + ": " + beyond + "if the images are in finer units than the scale says (0.2 mm or "
+         "TUM RGB-D's 1/5000: 0.0002; 0.1 mm: 0.0001), set depth.scale; if sensor.model names another sensor, set "
+         "it; otherwise expect noise beyond the sensor's specification";
 }
 
 /// The depth of an image file (depthFromImage).

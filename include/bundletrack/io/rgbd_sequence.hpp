@@ -65,14 +65,17 @@ class RgbdSequence {
       for (const std::string& object : objects_)
         if (const auto m = mask(0, object)) visible |= *m;
       if (cv::countNonZero(visible) == 0) visible.setTo(255);
-      checkDepthScale(rawDepth(0), visible, depth_scale_, depthPath(0), settings_.frame.sensor.max_range);
+      warnDepthScale(checkDepthScale(rawDepth(0), visible, depth_scale_, depthPath(0), settings_.frame.sensor.max_range));
       return;
     }
     const auto first_mask = mask(0);
     if (!first_mask) throw InputError(maskPath(0), "the first frame needs an object mask: file not found");
     if (cv::countNonZero(*first_mask) == 0) throw InputError(maskPath(0), "the first frame's object mask is empty");
-    checkDepthScale(rawDepth(0), *first_mask, depth_scale_, depthPath(0), settings_.frame.sensor.max_range);
+    warnDepthScale(checkDepthScale(rawDepth(0), *first_mask, depth_scale_, depthPath(0), settings_.frame.sensor.max_range));
   }
+
+  /// What the reader found doubtful but not wrong (checkDepthScale's caution), for the user to see.
+  const std::vector<std::string>& warnings() const { return warnings_; }
 
   /// The objects of a sequence with a folder of masks per object (in name order) or with label
   /// images (in the order of labels/objects.txt); empty for a sequence of one object
@@ -157,6 +160,10 @@ class RgbdSequence {
   std::vector<Eigen::Vector3f> modelPoints(const std::string& object = {}) const { return readPoints(modelPath(object)); }
 
  private:
+  void warnDepthScale(std::string caution) {
+    if (!caution.empty()) warnings_.push_back(std::move(caution));
+  }
+
   void requireSize(const cv::Mat& image, const std::filesystem::path& path) const {
     if (image.size() != image_size_)
       throw InputError(path, "image is " + std::to_string(image.cols) + "x" + std::to_string(image.rows) +
@@ -210,6 +217,7 @@ class RgbdSequence {
   FrameFiles frames_;
   std::vector<std::string> objects_;
   std::vector<int> labels_;  ///< of each object, in a sequence with label images (else empty)
+  std::vector<std::string> warnings_;
   double depth_scale_ = 0.001;
   PinholeCamerad camera_;
   cv::Size image_size_;
