@@ -226,6 +226,14 @@ py::dict modelArrays(const std::vector<bt::ModelPoint>& model) {
   return out;
 }
 
+/// A later frame's colour image must have the first frame's size.
+void requireFirstSize(const cv::Mat& color, cv::Size first) {
+  if (color.size() != first)
+    throw bt::InputError("rgb", "image is " + std::to_string(color.cols) + "x" + std::to_string(color.rows) +
+                                    " but the first frame's is " + std::to_string(first.width) + "x" +
+                                    std::to_string(first.height));
+}
+
 /// Metres per unit of uint16 depth arrays: depth.scale, or millimetres when it is 0 (the layout's).
 double depthScaleOf(const bt::Config& config) { return config.sequence.depth_scale > 0.0 ? config.sequence.depth_scale : 0.001; }
 
@@ -264,10 +272,7 @@ class PyTracker {
   Result track(const py::handle& rgb, const py::handle& depth, const py::handle& mask) {
     if (!tracker_) throw std::runtime_error("track() called before initialize()");
     MatView color = colorArgument(rgb);
-    if (color.mat.size() != size_)
-      throw bt::InputError("rgb", "image is " + std::to_string(color.mat.cols) + "x" + std::to_string(color.mat.rows) +
-                                      " but the first frame's is " + std::to_string(size_.width) + "x" +
-                                      std::to_string(size_.height));
+    requireFirstSize(color.mat, size_);
     py::array depth_owner;
     const cv::Mat metres = depthArgument(depth, depthScaleOf(config_), size_, depth_owner);
     const bool propagated = config_.masks == "propagated";
@@ -334,11 +339,8 @@ class PyMultiTracker {
     if (frames_ == 0) {
       bt::io::checkFieldOfView(camera_, color.mat.size(), "K");
       size_ = color.mat.size();
-    } else if (color.mat.size() != size_) {
-      throw bt::InputError("rgb", "image is " + std::to_string(color.mat.cols) + "x" + std::to_string(color.mat.rows) +
-                                      " but the first frame's is " + std::to_string(size_.width) + "x" +
-                                      std::to_string(size_.height));
     }
+    requireFirstSize(color.mat, size_);
     py::array depth_owner;
     const cv::Mat metres = depthArgument(depth, depthScaleOf(config_), size_, depth_owner);
     const py::dict given = namedArgument(masks, "masks");

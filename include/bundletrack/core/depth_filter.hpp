@@ -103,23 +103,36 @@ inline cv::Mat smoothDepth(const cv::Mat& depth, const DepthFilterSettings& s, c
         const int u0 = std::max(0, u - r), u1 = std::min(depth.cols - 1, u + r);
         const float window = noise.widen(s.smooth_depth_window, z);
         // Weighted moments of the admitted neighbours (offsets du, dv, dz from the pixel). Invalid
-        // readings are 0 and fail the window test, which keeps the inner loop branch-free.
-        float w0 = 0, wu = 0, wv = 0, wuu = 0, wuv = 0, wvv = 0, wz = 0, wuz = 0, wvz = 0;
+        // readings are 0 and fail the window test, which keeps the inner loops branch-free.
+        float w0 = 0, wz = 0;
+        int admitted = 0;
         for (int vv = v0; vv <= v1; ++vv) {
           const float* row = depth.ptr<float>(vv);
           const float* w = &spatial[std::size_t((vv - v + r) * width - u + r)];
-          const float dv = float(vv - v);
           for (int uu = u0; uu <= u1; ++uu) {
-            const float dz = row[uu] - z, du = float(uu - u);
-            const float weight = float(std::abs(dz) < window) * w[uu];
-            w0 += weight, wz += weight * dz;
-            if (!plane) continue;
-            wu += weight * du, wv += weight * dv, wuu += weight * du * du, wuv += weight * du * dv;
-            wvv += weight * dv * dv, wuz += weight * du * dz, wvz += weight * dv * dz;
+            const float dz = row[uu] - z;
+            const bool in = std::abs(dz) < window;
+            admitted += in;
+            w0 += float(in) * w[uu], wz += float(in) * w[uu] * dz;
           }
         }
         float offset = wz / w0;  // the centre itself is always admitted
-        if (plane) {
+        // With every neighbour of the whole window admitted the design is symmetric (the first
+        // moments vanish), and the plane's value at the pixel is the mean: the plane's other
+        // moments are needed only where neighbours are missing or refused.
+        if (plane && admitted < width * width) {
+          float wu = 0, wv = 0, wuu = 0, wuv = 0, wvv = 0, wuz = 0, wvz = 0;
+          for (int vv = v0; vv <= v1; ++vv) {
+            const float* row = depth.ptr<float>(vv);
+            const float* w = &spatial[std::size_t((vv - v + r) * width - u + r)];
+            const float dv = float(vv - v);
+            for (int uu = u0; uu <= u1; ++uu) {
+              const float dz = row[uu] - z, du = float(uu - u);
+              const float weight = float(std::abs(dz) < window) * w[uu];
+              wu += weight * du, wv += weight * dv, wuu += weight * du * du, wuv += weight * du * dv;
+              wvv += weight * dv * dv, wuz += weight * du * dz, wvz += weight * dv * dz;
+            }
+          }
           // The normal equations' solution for a (Cramer's rule); where they are singular (the
           // admitted neighbours on one line) the mean stays.
           const double det = double(w0) * (double(wuu) * wvv - double(wuv) * wuv) -

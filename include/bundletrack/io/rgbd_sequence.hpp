@@ -192,7 +192,6 @@ class RgbdSequence {
     if (!std::filesystem::exists(root_ / "labels")) return names;
     if (std::filesystem::exists(maskPath(0)) || !names.empty())
       throw InputError(root_ / "labels", "the sequence has both label images and masks/: keep one of them");
-    names.clear();
     for (const auto& [label, name] : readLabelNames(labelNamesPath())) {
       labels_.push_back(label);
       names.push_back(name);
