@@ -50,7 +50,8 @@ const char* const kUsage = R"(usage: bundletrack_track --sequence DIR --out DIR 
   --inlier-mm D      RANSAC inlier distance in millimetres (5; widened by the sensor's noise)
   --sensor S         structured_light (Kinect v1, Xtion) | active_stereo (RealSense D4xx) |
                      time_of_flight (Azure Kinect): the depth noise every depth tolerance widens
-                     with (sensor.model; structured_light)
+                     with (sensor.model; structured_light); loads the preset's numbers over any
+                     sensor.* of --config (refine a preset with sensor.* keys in the file)
   --gpu              matching, dense term, PCG and RANSAC on a CUDA device (compute.device: gpu;
                      needs a build with the CUDA backend and a GPU; keypoints stay on the CPU)
   --propagate-masks  the tracker gets only the first frame's mask and follows the object from it

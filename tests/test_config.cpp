@@ -57,6 +57,30 @@ TEST_CASE("configuration values land in the settings they name, and printing rea
   CHECK(bt::printConfig(bt::loadConfig(writeFile(dir, "empty.yaml", ""))) == bt::printConfig({}));
 }
 
+TEST_CASE("sensor keys refine the chosen preset in any order, and the printed configuration reads them back") {
+  TempDir dir("sensor_config");
+  // The numbers before the preset in the file: the preset still applies first.
+  const bt::Config config =
+      bt::loadConfig(writeFile(dir, "s.yaml", "sensor:\n  subpixel: 0.05\n  baseline: 0.095\n  model: active_stereo\n"));
+  bt::DepthNoise expected = bt::DepthNoise::activeStereo();
+  expected.subpixel = 0.05;
+  expected.baseline = 0.095;
+  CHECK(config.sequence.frame.sensor == expected);
+  // A D455 (95 mm baseline) at 2 m with a 640 px focal length: 4 m^2 0.05 px / (640 px 0.095 m).
+  CHECK(config.sequence.frame.sensor.sigma(2.0, 640.0) == doctest::Approx(4.0 * 0.05 / (640.0 * 0.095)));
+  const std::string printed = bt::printConfig(config);
+  CHECK(printed.find("  model: active_stereo\n") != std::string::npos);
+  const bt::Config again = bt::loadConfig(writeFile(dir, "again.yaml", printed));
+  CHECK(again.sequence.frame.sensor == expected);
+  // Without a preset the numbers refine the default one.
+  const bt::Config refined = bt::loadConfig(writeFile(dir, "r.yaml", "sensor:\n  quadratic: 0.0025\n"));
+  expected = bt::DepthNoise::structuredLight();
+  expected.quadratic = 0.0025;
+  CHECK(refined.sequence.frame.sensor == expected);
+  CHECK_THROWS_WITH_AS(bt::loadConfig(writeFile(dir, "bad.yaml", "sensor:\n  baseline: 0\n")),
+                       doctest::Contains("sensor.baseline = 0 is out of range"), bt::InputError);
+}
+
 TEST_CASE("bad configuration files name the file and the key") {
   TempDir dir("badconfig");
   const auto expect = [&](const std::string& text, const std::string& problem) {

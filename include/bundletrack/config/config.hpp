@@ -1,5 +1,6 @@
 #pragma once
 
+#include <algorithm>
 #include <cstddef>
 #include <functional>
 #include <limits>
@@ -94,6 +95,33 @@ ConfigChoice enumChoice(Enum& value, std::vector<std::pair<std::string, Enum>> o
           }};
 }
 
+/// The sensor's preset: setting a name loads its numbers, which the sensor.* keys then refine.
+/// Read back, a sensor whose numbers were refined names the preset sharing most of them (so the
+/// printed configuration, preset then numbers, reads back to the same sensor).
+inline ConfigChoice sensorChoice(DepthNoise& sensor) {
+  const std::vector<std::pair<std::string, DepthNoise>> presets = {{"structured_light", DepthNoise::structuredLight()},
+                                                                   {"active_stereo", DepthNoise::activeStereo()},
+                                                                   {"time_of_flight", DepthNoise::timeOfFlight()}};
+  const auto shared = [](const DepthNoise& a, const DepthNoise& b) {
+    return (a.base == b.base) + (a.linear == b.linear) + (a.quadratic == b.quadratic) + (a.offset == b.offset) +
+           (a.subpixel == b.subpixel) + (a.baseline == b.baseline) + (a.disparity_step == b.disparity_step) +
+           (a.max_range == b.max_range);
+  };
+  std::vector<std::string> names;
+  for (const auto& preset : presets) names.push_back(preset.first);
+  return {std::move(names),
+          [&sensor, presets, shared] {
+            const auto nearest = std::max_element(presets.begin(), presets.end(), [&](const auto& a, const auto& b) {
+              return shared(a.second, sensor) < shared(b.second, sensor);
+            });
+            return nearest->first;
+          },
+          [&sensor, presets](const std::string& name) {
+            for (const auto& [preset_name, preset] : presets)
+              if (preset_name == name) sensor = preset;
+          }};
+}
+
 }  // namespace detail
 
 /// The table of every setting of `c`, in the order they are printed and documented.
@@ -102,6 +130,7 @@ inline std::vector<ConfigEntry> configEntries(Config& c) {
   auto& depth = c.sequence.frame.depth_filter;
   auto& t = c.tracking;
   auto& m = c.propagated_masks;
+  auto& sensor = c.sequence.frame.sensor;
   using detail::enumChoice, detail::textChoice;
   return {
       {"tracker", "type", textChoice(c.tracker, {"full", "coarse"}), 0, 0, "",
@@ -122,12 +151,16 @@ inline std::vector<ConfigEntry> configEntries(Config& c) {
       {"depth", "smoothing", enumChoice(depth.smoothing, {{"mean", DepthSmoothing::Mean}, {"plane_fit", DepthSmoothing::PlaneFit}}), 0, 0, "",
        "mean: each pixel the weighted mean of its neighbours within the window; plane_fit: their weighted plane's value at the pixel"},
       {"depth", "normal_max_depth_jump", &c.sequence.frame.normal_max_depth_jump, 0.0, 1.0, "m", "no normal across a larger depth jump"},
-      {"sensor", "model",
-       enumChoice(c.sequence.frame.sensor, {{"structured_light", DepthNoise::structuredLight()},
-                                            {"active_stereo", DepthNoise::activeStereo()},
-                                            {"time_of_flight", DepthNoise::timeOfFlight()}}),
-       0, 0, "",
-       "depth noise (Kinect v1 / Xtion, RealSense D4xx, Azure Kinect): every depth and distance tolerance widens with it beyond Kinect v1 at 1 m (docs/DESIGN.md)"},
+      {"sensor", "model", detail::sensorChoice(sensor), 0, 0, "",
+       "depth noise preset (Kinect v1 / Xtion, RealSense D4xx, Azure Kinect): every depth and distance tolerance widens with it beyond Kinect v1 at 1 m (docs/DESIGN.md); the sensor keys below refine it one by one"},
+      {"sensor", "base", &sensor.base, 0.0, 1.0, "m", "sigma(z) = base + linear z + quadratic (z - offset)^2 + z^2 subpixel / (f baseline): constant term"},
+      {"sensor", "linear", &sensor.linear, 0.0, 1.0, "m/m", "sigma's term proportional to depth (time of flight)"},
+      {"sensor", "quadratic", &sensor.quadratic, 0.0, 1.0, "m/m^2", "sigma's term in (z - offset)^2 (structured light)"},
+      {"sensor", "offset", &sensor.offset, 0.0, 10.0, "m", "the depth where the quadratic term vanishes"},
+      {"sensor", "subpixel", &sensor.subpixel, 0.0, 10.0, "px", "RMS disparity error of a stereo or structured-light match: sigma's term z^2 subpixel / (f baseline)"},
+      {"sensor", "baseline", &sensor.baseline, 1e-3, 10.0, "m", "projector-camera or stereo baseline"},
+      {"sensor", "disparity_step", &sensor.disparity_step, 0.0, 10.0, "px", "disparity quantisation: readings lie on a grid of depths this many pixels of disparity apart (0: none)"},
+      {"sensor", "max_range", &sensor.max_range, 0.0, 1000.0, "m", "farthest depth of the sensor's specification: the depth unit check warns beyond it (0: unknown)"},
       {"features", "type", textChoice(c.features, {"sift", "orb", "akaze"}), 0, 0, "", "keypoint detector and descriptor"},
       {"features", "detect", enumChoice(t.keypoints, {{"every_frame", KeypointSchedule::EveryFrame}, {"on_demand", KeypointSchedule::OnDemand}}), 0, 0, "",
        "every_frame: paper IV; on_demand: a frame is tracked by the dense term alone where its surface holds the pose and the verifier accepts it, keypoints are detected otherwise and on keyframes"},

@@ -144,6 +144,9 @@ inline Config parseConfig(std::string yaml, const std::filesystem::path& path) {
   for (const cv::FileNode section : root) {
     if (!section.isMap()) throw InputError(path, "'" + section.name() + "' must be a section of key: value pairs");
     once(seen_sections, section.name(), "section");
+    // A section's choices first, then its numbers, in any order in the file: a choice may be a
+    // preset (sensor.model) that the section's numbers refine.
+    std::vector<std::pair<const ConfigEntry*, cv::FileNode>> numbers;
     for (const cv::FileNode node : section) {
       const std::string name = section.name() + "." + node.name();
       once(seen_keys, name, "key");
@@ -155,9 +158,10 @@ inline Config parseConfig(std::string yaml, const std::filesystem::path& path) {
           throw InputError(path, name + " = '" + value + "': expected " + choice->alternatives());
         choice->set(value);
       } else {
-        detail::setNumber(*entry, node, path);
+        numbers.emplace_back(&*entry, node);
       }
     }
+    for (const auto& [entry, node] : numbers) detail::setNumber(*entry, node, path);
   }
   requireConsistent(config, path);
   return config;
