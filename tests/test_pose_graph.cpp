@@ -10,6 +10,7 @@
 #include "bundletrack/graph/keyframe_pool.hpp"
 #include "bundletrack/graph/object_model.hpp"
 #include "bundletrack/graph/relocalisation.hpp"
+#include "bundletrack/residuals/dense_photometric.hpp"
 #include "bundletrack/residuals/dense_point_to_plane.hpp"
 #include "bundletrack/residuals/feature_point_to_point.hpp"
 #include "bundletrack/solvers/dense_ldlt.hpp"
@@ -68,6 +69,15 @@ bt::Keyframe surfaceKeyframe(int id, const bt::SE3d& T_cam_obj, const bt::Pinhol
     }
   }
   bt::indexCells(k.surface);
+  // Brightness linear in the pixel, so that bilinear sampling is exact and its derivatives are the
+  // image's: the residual's dependence on the poses is then all in the projection.
+  k.image.box = cv::Rect(0, 0, 80, 60);
+  k.image.intensity.create(60, 80, CV_32FC1);
+  for (int v = 0; v < 60; ++v)
+    for (int u = 0; u < 80; ++u) k.image.intensity.at<float>(v, u) = 0.3f + 0.004f * float(u) + 0.003f * float(v) + 0.01f * float(id);
+  k.image.d_u = cv::Mat(60, 80, CV_32FC1, cv::Scalar(0.004));
+  k.image.d_v = cv::Mat(60, 80, CV_32FC1, cv::Scalar(0.003));
+  k.image.valid = cv::Mat(60, 80, CV_8UC1, cv::Scalar(255));
   return k;
 }
 
@@ -125,7 +135,7 @@ TEST_CASE_TEMPLATE("robust losses match their formulas and rho' is the derivativ
   CHECK(bt::TukeyLoss{}.evaluate(0.02 * 0.02).d_rho == 0.0);
 }
 
-TEST_CASE("feature and dense residual Jacobians equal central differences of the residuals") {
+TEST_CASE("feature, dense and photometric residual Jacobians equal central differences of the residuals") {
   std::mt19937 rng(3);
   const bt::PinholeCameraf grid{150.0f, 150.0f, 39.5f, 29.5f};
   const bt::SE3d T_i(bt::SO3d::exp(Eigen::Vector3d(2.8, 0.1, 0.0)), Eigen::Vector3d(0.0, 0.0, 0.6));
@@ -166,6 +176,7 @@ TEST_CASE("feature and dense residual Jacobians equal central differences of the
   };
   check(bt::FeaturePointToPoint{});
   check(bt::DensePointToPlane{});
+  check(bt::DensePhotometric{});
 }
 
 TEST_CASE("PCG and dense LDLT give the same update on a pose-graph system") {

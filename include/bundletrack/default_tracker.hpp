@@ -7,6 +7,7 @@
 #include "bundletrack/features/opencv_features.hpp"
 #include "bundletrack/masks/given_masks.hpp"
 #include "bundletrack/registration/ransac.hpp"
+#include "bundletrack/residuals/dense_photometric.hpp"
 #include "bundletrack/residuals/dense_point_to_plane.hpp"
 #include "bundletrack/residuals/feature_point_to_point.hpp"
 #include "bundletrack/robust/losses.hpp"
@@ -17,8 +18,11 @@
 
 namespace bundletrack {
 
-/// Paper eq. 1 with lambda_1 = lambda_2 = 1 and Huber losses (delta 5 mm).
-using DefaultEnergy = Energy<Term<FeaturePointToPoint, HuberLoss>, Term<DensePointToPlane, HuberLoss>>;
+/// Paper eq. 1 with lambda_1 = lambda_2 = 1 and Huber losses (delta 5 mm), and the photometric
+/// term beside them (beyond the paper, docs/DESIGN.md section 7).
+template <typename Dense = DensePointToPlane>
+using EnergyWithDense = Energy<Term<FeaturePointToPoint, HuberLoss>, Term<Dense, HuberLoss>, Term<DensePhotometric, HuberLoss>>;
+using DefaultEnergy = EnergyWithDense<>;
 
 /// BundleTrack with OpenCV's SIFT for the paper's learned features and the given masks for its
 /// video segmentation: Gauss-Newton with PCG, RANSAC, surface-agreement verification.

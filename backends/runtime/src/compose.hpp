@@ -34,13 +34,14 @@ inline RansacSettings ransacSettings(const Config& config) {
   return settings;
 }
 
-/// The default energy (paper eq. 1) with a dense term of type Dense.
+/// The default energy (paper eq. 1 and the photometric term) with a dense term of type Dense.
 template <typename Dense>
-Energy<Term<FeaturePointToPoint, HuberLoss>, Term<Dense, HuberLoss>> energy(const Config& config, Dense dense) {
-  Energy<Term<FeaturePointToPoint, HuberLoss>, Term<Dense, HuberLoss>> e{
-      {Term<FeaturePointToPoint, HuberLoss>{{}, config.feature_loss, 1.0}, Term<Dense, HuberLoss>{std::move(dense), config.dense_loss, 1.0}},
-      config.execution};
-  return e;
+EnergyWithDense<Dense> energy(const Config& config, Dense dense) {
+  DensePhotometric photometric = config.photometric;
+  photometric.gate = config.dense.gate;  // the dense term's association
+  return {{Term<FeaturePointToPoint, HuberLoss>{{}, config.feature_loss, 1.0}, Term<Dense, HuberLoss>{std::move(dense), config.dense_loss, 1.0},
+           Term<DensePhotometric, HuberLoss>{photometric, config.photometric_loss, config.photometric_weight}},
+          config.execution};
 }
 
 /// The full CPU tracker with the given mask source.

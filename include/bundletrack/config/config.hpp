@@ -14,6 +14,7 @@
 #include "bundletrack/io/rgbd_sequence.hpp"
 #include "bundletrack/masks/propagated_masks.hpp"
 #include "bundletrack/registration/ransac.hpp"
+#include "bundletrack/residuals/dense_photometric.hpp"
 #include "bundletrack/residuals/dense_point_to_plane.hpp"
 #include "bundletrack/robust/losses.hpp"
 #include "bundletrack/solvers/pcg.hpp"
@@ -38,6 +39,9 @@ struct Config {
   HuberLoss feature_loss;
   HuberLoss dense_loss;
   DensePointToPlane dense;
+  DensePhotometric photometric;
+  HuberLoss photometric_loss{0.1};
+  double photometric_weight = 1.0;  ///< lambda of the photometric term (0: off)
   PCG pcg;
   std::string masks = "given";  ///< given | propagated
   PropagatedMaskSettings propagated_masks;
@@ -199,6 +203,9 @@ inline std::vector<ConfigEntry> configEntries(Config& c) {
       {"energy", "dense_huber_delta", &c.dense_loss.delta, 1e-6, 1.0, "m", "Huber delta of the dense term (paper eq. 3)"},
       {"energy", "dense_max_distance", &c.dense.gate.max_distance, 0.0, 1.0, "m", "dense association: points farther apart are not paired"},
       {"energy", "dense_max_normal_angle_deg", &c.dense.gate.max_normal_angle_deg, 0.0, 180.0, "deg", "dense association: nor normals farther apart"},
+      {"energy", "photometric_weight", &c.photometric_weight, 0.0, 1000.0, "", "lambda of the photometric term: brightness constancy of the surface points between frames (0: off)"},
+      {"energy", "photometric_sigma", &c.photometric.sigma, 1e-4, 1.0, "", "expected brightness change of a surface point between views (intensity 0-1): the term's weight beside the depth noise"},
+      {"energy", "photometric_huber_delta", &c.photometric_loss.delta, 1e-6, 1.0, "", "Huber delta of the photometric term (intensity 0-1)"},
       {"solver", "step_control", enumChoice(t.gauss_newton.step_control, {{"none", StepControl::None}, {"levenberg_marquardt", StepControl::LevenbergMarquardt}}), 0, 0, "",
        "none: every Gauss-Newton step is taken (paper); levenberg_marquardt: damped, a step that raises the energy is rejected"},
       {"solver", "min_translation_step", &t.gauss_newton.min_translation_step, 0.0, 1.0, "m", "Gauss-Newton stops when no node moves more ..."},

@@ -2,6 +2,7 @@
 
 #include <string>
 
+#include "bundletrack/core/intensity_image.hpp"
 #include "bundletrack/core/rgbd_frame.hpp"
 #include "bundletrack/core/se3.hpp"
 #include "bundletrack/core/surface_grid.hpp"
@@ -9,20 +10,24 @@
 
 namespace bundletrack {
 
-/// What the pose graph keeps of a frame: its pose, its features (paper eq. 2) and its surface on
-/// the dense grid (paper eq. 3).
+/// What the pose graph keeps of a frame: its pose, its features (paper eq. 2), its surface on
+/// the dense grid (paper eq. 3) and its brightness around the object (the photometric term).
 struct Keyframe {
   int id = 0;  ///< frame index in the sequence
   std::string name;
   SE3d T_cam_obj;
   FrameFeatures features;
   SurfaceGrid surface;
+  IntensityImage image;
 };
 
-/// The keyframe of `frame` under `mask`, its surface sampled every `grid_step` pixels.
+/// The keyframe of `frame` under `mask`, its surface sampled every `grid_step` pixels; its
+/// intensity image reaches two grid steps beyond the mask, as far as a point associated with the
+/// surface (within one cell of it) can project.
 inline Keyframe makeKeyframe(int id, const RgbdFrame& frame, const cv::Mat& mask, FrameFeatures features,
                              const SE3d& T_cam_obj, const PinholeCameraf& camera, int grid_step) {
-  return {id, frame.name, T_cam_obj, std::move(features), sampleSurface(frame, mask, camera, grid_step)};
+  return {id, frame.name, T_cam_obj, std::move(features), sampleSurface(frame, mask, camera, grid_step),
+          makeIntensityImage(frame.color, mask, 2 * grid_step)};
 }
 
 }  // namespace bundletrack

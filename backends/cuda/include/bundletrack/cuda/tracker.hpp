@@ -8,9 +8,9 @@
 
 namespace bundletrack::cuda {
 
-/// bundletrack::DefaultEnergy with the dense term on the GPU (the feature term stays on the CPU:
-/// a few hundred residuals per edge).
-using DefaultEnergy = Energy<Term<FeaturePointToPoint, HuberLoss>, Term<DensePointToPlane, HuberLoss>>;
+/// bundletrack::DefaultEnergy with the dense term on the GPU (the feature and photometric terms
+/// stay on the CPU: a few hundred residuals per edge).
+using DefaultEnergy = EnergyWithDense<DensePointToPlane>;
 
 /// The tracker with every GPU policy of this backend: dense term, PCG, descriptor matching and
 /// RANSAC on the device; the Detector finds keypoints on the CPU, the verification runs there.

@@ -1,0 +1,72 @@
+#pragma once
+
+#include <cmath>
+
+#include <opencv2/core.hpp>
+#include <opencv2/imgproc.hpp>
+
+namespace bundletrack {
+
+/// A frame's brightness on the object, as the photometric term reads it: the grey image lightly
+/// smoothed (so that its derivatives are the scene's, not the sensor's pixel noise) less its local
+/// mean over the object (a Gaussian of `kLocalMeanSigma` over object pixels only), and the
+/// derivatives along u and v, over `box` (full-resolution pixels). Taking the local mean away keeps
+/// the texture and drops the slow brightness change that shading under a light fixed to the camera
+/// (or the world) paints on a turning object; it is defined `valid` only where the smoothing and
+/// the derivatives see object pixels alone, so the background never enters.
+struct IntensityImage {
+  static constexpr double kLocalMeanSigma = 3.0;  ///< pixels
+  cv::Mat intensity, d_u, d_v;  ///< CV_32FC1, box.size()
+  cv::Mat valid;  ///< CV_8UC1, box.size(): non-zero where intensity and derivatives are defined
+  cv::Rect box;
+
+  bool empty() const { return intensity.empty(); }
+
+  /// Bilinear intensity and derivatives at full-resolution pixel (u, v) (centres at integers);
+  /// false where the four neighbours are not all valid.
+  bool sample(double u, double v, double& value, double& du, double& dv) const {
+    const double x = u - box.x, y = v - box.y;
+    const int x0 = int(std::floor(x)), y0 = int(std::floor(y));
+    if (x0 < 0 || y0 < 0 || x0 + 1 >= box.width || y0 + 1 >= box.height) return false;
+    const uchar* m0 = valid.ptr<uchar>(y0) + x0;
+    const uchar* m1 = valid.ptr<uchar>(y0 + 1) + x0;
+    if (!(m0[0] && m0[1] && m1[0] && m1[1])) return false;
+    const double a = x - x0, b = y - y0;
+    const auto mix = [&](const cv::Mat& m) {
+      const float* r0 = m.ptr<float>(y0) + x0;
+      const float* r1 = m.ptr<float>(y0 + 1) + x0;
+      return (1 - b) * ((1 - a) * r0[0] + a * r0[1]) + b * ((1 - a) * r1[0] + a * r1[1]);
+    };
+    value = mix(intensity), du = mix(d_u), dv = mix(d_v);
+    return true;
+  }
+};
+
+/// The intensity image of `bgr` on `mask`, over the mask's bounding box grown by `margin` pixels
+/// (empty without a colour image or a mask pixel). Smoothing: a 3x3 Gaussian (sigma 0.8 px);
+/// derivatives: the 3x3 Sobel operator over 8, in intensity (0-1) per pixel; valid: the mask eroded
+/// by the two 3x3 stencils.
+inline IntensityImage makeIntensityImage(const cv::Mat& bgr, const cv::Mat& mask, int margin) {
+  IntensityImage image;
+  if (bgr.empty() || mask.empty()) return image;
+  const cv::Rect object = cv::boundingRect(mask);
+  if (object.area() == 0) return image;
+  image.box = cv::Rect(object.x - margin, object.y - margin, object.width + 2 * margin, object.height + 2 * margin) &
+              cv::Rect({0, 0}, bgr.size());
+  cv::Mat gray, smooth, on_object, weighted, coverage;
+  cv::cvtColor(bgr(image.box), gray, cv::COLOR_BGR2GRAY);
+  gray.convertTo(gray, CV_32F, 1.0 / 255.0);
+  cv::GaussianBlur(gray, smooth, {3, 3}, 0.8, 0.8, cv::BORDER_REPLICATE);
+  mask(image.box).convertTo(on_object, CV_32F, 1.0 / 255.0);
+  const double s = IntensityImage::kLocalMeanSigma;
+  const cv::Size window(2 * int(std::ceil(3 * s)) + 1, 2 * int(std::ceil(3 * s)) + 1);
+  cv::GaussianBlur(smooth.mul(on_object), weighted, window, s, s, cv::BORDER_CONSTANT);
+  cv::GaussianBlur(on_object, coverage, window, s, s, cv::BORDER_CONSTANT);
+  image.intensity = smooth - weighted / cv::max(coverage, 1e-6);
+  cv::Sobel(image.intensity, image.d_u, CV_32F, 1, 0, 3, 1.0 / 8.0, 0.0, cv::BORDER_REPLICATE);
+  cv::Sobel(image.intensity, image.d_v, CV_32F, 0, 1, 3, 1.0 / 8.0, 0.0, cv::BORDER_REPLICATE);
+  cv::erode(mask(image.box), image.valid, cv::Mat(), {-1, -1}, 2, cv::BORDER_CONSTANT, cv::Scalar(0));
+  return image;
+}
+
+}  // namespace bundletrack
