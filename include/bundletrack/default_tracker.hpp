@@ -3,6 +3,8 @@
 // The paper's choices of every policy, composed into DefaultTracker. A tracker of your own
 // composes bundletrack/tracker.hpp with the policy headers it needs.
 
+#include <utility>
+
 #include "bundletrack/energy.hpp"
 #include "bundletrack/features/opencv_features.hpp"
 #include "bundletrack/masks/given_masks.hpp"
@@ -20,8 +22,14 @@ namespace bundletrack {
 
 /// Paper eq. 1 with lambda_1 = lambda_2 = 1 and Huber losses (delta 5 mm), and the photometric
 /// term beside them (beyond the paper, docs/DESIGN.md section 7).
+/// Default-constructed, each term has its own default: the photometric term's Huber delta is in
+/// intensity (DensePhotometric::kHuberDelta), the others' 5 mm.
 template <typename Dense = DensePointToPlane>
-using EnergyWithDense = Energy<Term<FeaturePointToPoint, HuberLoss>, Term<Dense, HuberLoss>, Term<DensePhotometric, HuberLoss>>;
+struct EnergyWithDense : Energy<Term<FeaturePointToPoint, HuberLoss>, Term<Dense, HuberLoss>, Term<DensePhotometric, HuberLoss>> {
+  using Base = Energy<Term<FeaturePointToPoint, HuberLoss>, Term<Dense, HuberLoss>, Term<DensePhotometric, HuberLoss>>;
+  EnergyWithDense() : Base{{{}, {}, {{}, HuberLoss{DensePhotometric::kHuberDelta}, 1.0}}} {}
+  explicit EnergyWithDense(Base energy) : Base(std::move(energy)) {}
+};
 using DefaultEnergy = EnergyWithDense<>;
 
 /// BundleTrack with OpenCV's SIFT for the paper's learned features and the given masks for its

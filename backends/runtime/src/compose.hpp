@@ -39,9 +39,10 @@ template <typename Dense>
 EnergyWithDense<Dense> energy(const Config& config, Dense dense) {
   DensePhotometric photometric = config.photometric;
   photometric.gate = config.dense.gate;  // the dense term's association
-  return {{Term<FeaturePointToPoint, HuberLoss>{{}, config.feature_loss, 1.0}, Term<Dense, HuberLoss>{std::move(dense), config.dense_loss, 1.0},
-           Term<DensePhotometric, HuberLoss>{photometric, config.photometric_loss, config.photometric_weight}},
-          config.execution};
+  return EnergyWithDense<Dense>(
+      {{Term<FeaturePointToPoint, HuberLoss>{{}, config.feature_loss, 1.0}, Term<Dense, HuberLoss>{std::move(dense), config.dense_loss, 1.0},
+        Term<DensePhotometric, HuberLoss>{photometric, config.photometric_loss, config.photometric_weight}},
+       config.execution});
 }
 
 /// The full CPU tracker with the given mask source.

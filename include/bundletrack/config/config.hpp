@@ -40,7 +40,7 @@ struct Config {
   HuberLoss dense_loss;
   DensePointToPlane dense;
   DensePhotometric photometric;
-  HuberLoss photometric_loss{0.1};
+  HuberLoss photometric_loss{DensePhotometric::kHuberDelta};
   double photometric_weight = 1.0;  ///< lambda of the photometric term (0: off)
   PCG pcg;
   std::string masks = "given";  ///< given | propagated

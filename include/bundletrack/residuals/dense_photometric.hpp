@@ -32,6 +32,9 @@ struct DensePhotometric {
   /// their shading (ADD-S 95.2 -> 92.7 at 0.25), with more the 2 m mug's twist is held less
   /// (mean rotation error 31 degrees at 0.4, 52 at 0.6, 91 without the term).
   double sigma = 0.4;
+  /// Intensity: the Huber delta its energy uses by default (a brightness difference beyond it,
+  /// an occlusion or a highlight, counts linearly).
+  static constexpr double kHuberDelta = 0.1;
 
   struct Input {
     const SurfaceGrid& surface_i;
