@@ -107,7 +107,7 @@ TEST_CASE("full tracker on a synthetic hand-held box: ADD-S AUC >= 95 and less d
   CHECK(full.score.final_add_cm < coarse.score.final_add_cm);
 }
 
-TEST_CASE("brightness keeps a small textured mug's turn at 2 m, where its surface cannot" * doctest::test_suite("end_to_end")) {
+TEST_CASE("brightness keeps a small textured mug's turn at 2 m where its surface cannot" * doctest::test_suite("end_to_end")) {
   // The stress matrix's A_mug_2m_textured: a 10 cm mug 2 m away fills about 20 x 20 pixels, and
   // structured-light depth there (7 mm spread, 13 mm disparity steps) does not see its curvature
   // nor much of its handle: the turn about its axis is left to the texture. Without it the turn
