@@ -1,7 +1,7 @@
 // The pose graph's pieces on data from a tracker run: linear solvers on its normal equations, PCG
 // (the tracker's truncated 5 iterations, and to convergence) vs dense LDLT vs Eigen's
 // ConjugateGradient, for graphs of 2..64 nodes; residual evaluation and assembly throughput of the
-// feature and dense terms; greedy keyframe selection. Systems come from a synthetic hand-held box tracked with keyframes every
+// feature, dense and photometric terms; greedy keyframe selection. Systems come from a synthetic hand-held box tracked with keyframes every
 // 2.5 degrees, so that 64 keyframes exist; edges carry matched and RANSAC-pruned features and the
 // dense term, as in the tracker.
 #include <benchmark/benchmark.h>
@@ -93,9 +93,8 @@ const System& systemOfSize(int nodes) {
 
 /// Residual evaluation and normal-equation assembly of one energy term over a whole graph.
 template <typename EnergyT>
-void assemble(benchmark::State& state) {
+void assemble(benchmark::State& state, const EnergyT& energy = {}) {
   const bt::PoseGraph& graph = graphOfSize(int(state.range(0)));
-  const EnergyT energy;
   const auto problem = energy.over(graph);
   bt::Linearisation at;
   for (auto _ : state) {
@@ -112,6 +111,11 @@ void BM_AssembleFeatureTerm(benchmark::State& state) {
 
 void BM_AssembleDenseTerm(benchmark::State& state) {
   assemble<bt::Energy<bt::Term<bt::DensePointToPlane, bt::HuberLoss>>>(state);
+}
+
+void BM_AssemblePhotometricTerm(benchmark::State& state) {
+  using Photometric = bt::Term<bt::DensePhotometric, bt::HuberLoss>;
+  assemble(state, bt::Energy<Photometric>{{Photometric{{}, bt::HuberLoss{bt::DensePhotometric::kHuberDelta}, 1.0}}});
 }
 
 /// Greedy selection of 15 keyframes (paper IV-C) from pools of growing size.
@@ -173,5 +177,6 @@ BENCHMARK(BM_DenseLDLT)->RangeMultiplier(2)->Range(2, 64)->Unit(benchmark::kMicr
 BENCHMARK(BM_EigenConjugateGradient)->RangeMultiplier(2)->Range(2, 64)->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_AssembleFeatureTerm)->RangeMultiplier(2)->Range(2, 64)->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_AssembleDenseTerm)->RangeMultiplier(2)->Range(2, 64)->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_AssemblePhotometricTerm)->RangeMultiplier(2)->Range(2, 64)->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_SelectKeyframes)->RangeMultiplier(4)->Range(16, 1024)->Unit(benchmark::kMicrosecond);
 BENCHMARK_MAIN();

@@ -54,19 +54,21 @@ scoring=$("$build/bin/bench_scoring" --benchmark_format=csv 2>/dev/null)
   echo
   echo "## Residual evaluation and normal-equation assembly (bench_solvers)"
   echo
-  echo "All edges of the same graphs, one term each (a feature residual is one 3-vector). Throughput"
-  echo "relative to the dense term's at 16 nodes in this run."
+  echo "All edges of the same graphs, one term each (a feature residual is one 3-vector; dense:"
+  echo "point-to-plane; photometric: brightness, Huber delta 0.1). Throughput relative to the dense"
+  echo "term's at 16 nodes in this run."
   echo
-  echo "| nodes | feature residuals | feature throughput | dense residuals | dense throughput |"
-  echo "|---|---|---|---|---|"
+  echo "| nodes | feature residuals | feature throughput | dense residuals | dense throughput | photometric residuals | photometric throughput |"
+  echo "|---|---|---|---|---|---|---|"
   echo "$assembly" | awk -F, "$columns"'
     /BM_Assemble/ { split($1, p, "/"); name = p[1]; gsub(/"/, "", name); n = p[2] + 0
       count[name, n] = $(col["residuals"]); rate[name, n] = $(col["residuals_per_second"]); seen[n] = 1 }
     END {
       ref = rate["BM_AssembleDenseTerm", 16]
       for (n = 2; n <= 64; n *= 2) if (seen[n])
-        printf "| %d | %d | %.2f | %d | %.2f |\n", n, count["BM_AssembleFeatureTerm", n], rate["BM_AssembleFeatureTerm", n] / ref,
-               count["BM_AssembleDenseTerm", n], rate["BM_AssembleDenseTerm", n] / ref
+        printf "| %d | %d | %.2f | %d | %.2f | %d | %.2f |\n", n, count["BM_AssembleFeatureTerm", n], rate["BM_AssembleFeatureTerm", n] / ref,
+               count["BM_AssembleDenseTerm", n], rate["BM_AssembleDenseTerm", n] / ref,
+               count["BM_AssemblePhotometricTerm", n], rate["BM_AssemblePhotometricTerm", n] / ref
     }'
   echo
   echo "## Greedy keyframe selection of 15 (bench_solvers)"

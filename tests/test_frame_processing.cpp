@@ -3,6 +3,7 @@
 
 #include <random>
 
+#include "bundletrack/core/intensity_image.hpp"
 #include "bundletrack/core/rgbd_frame.hpp"
 #include "bundletrack/core/se3.hpp"
 
@@ -170,4 +171,63 @@ TEST_CASE("a frame preprocessed inside a region equals the whole image's preproc
       CHECK(cv::countNonZero(left.reshape(1)) == 0);
     }
   }
+}
+
+TEST_CASE("the intensity image drops shading and the background and holds each grid cell's intensity") {
+  // An object (mask: a rectangle) under linear shading, grey 0.3 + 0.002 u, on a white background.
+  const cv::Size size(120, 100);
+  const cv::Rect object(20, 20, 80, 60);
+  cv::Mat mask = cv::Mat::zeros(size, CV_8UC1), bgr(size, CV_8UC3, cv::Scalar::all(255));
+  mask(object).setTo(255);
+  for (int v = object.y; v < object.br().y; ++v)
+    for (int u = object.x; u < object.br().x; ++u) bgr.at<cv::Vec3b>(v, u) = cv::Vec3b::all(uchar(std::lround(255.0 * (0.3 + 0.002 * u))));
+  const bt::IntensityImage image = bt::makeIntensityImage(bgr, mask, 4);
+  REQUIRE(image.box == cv::Rect(16, 16, 88, 68));
+  // Valid: the mask eroded by 2 px.
+  const auto valid = [&](int u, int v) { return image.valid.at<uchar>(v - image.box.y, u - image.box.x) != 0; };
+  CHECK(valid(object.x + 2, 50));
+  CHECK_FALSE(valid(object.x + 1, 50));
+  CHECK_FALSE(valid(object.br().x - 2, 50));
+  CHECK(valid(object.br().x - 3, 50));
+  // The local mean of a linear ramp is the ramp: inside, the image is the 8-bit rounding alone
+  // (< 0.5 / 255 ~ 0.002), where the raw grey spans 0.16. Near the border the mean is over object
+  // pixels only, so the white background (0.7 brighter) leaves little: a 3x3 smoothing's share.
+  double worst_inside = 0.0, worst_border = 0.0;
+  for (int v = object.y + 2; v < object.br().y - 2; ++v)
+    for (int u = object.x + 2; u < object.br().x - 2; ++u) {
+      double value = 0.0, du = 0.0, dv = 0.0;
+      REQUIRE(image.sample(u, v, value, du, dv) == (u < object.br().x - 3 && v < object.br().y - 3));
+      const bool interior = cv::Rect(object.x + 10, object.y + 10, object.width - 20, object.height - 20).contains({u, v});
+      const double magnitude = std::abs(image.samples.at<cv::Vec3f>(v - image.box.y, u - image.box.x)[0]);
+      (interior ? worst_inside : worst_border) = std::max(interior ? worst_inside : worst_border, magnitude);
+    }
+  CHECK(worst_inside < 0.003);
+  CHECK(worst_border < 0.05);
+  // Bilinear sampling at a pixel corner is the mean of the four pixels around it.
+  const auto at = [&](int u, int v) { return image.samples.at<cv::Vec3f>(v - image.box.y, u - image.box.x); };
+  double value = 0.0, du = 0.0, dv = 0.0;
+  REQUIRE(image.sample(40.5, 30.5, value, du, dv));
+  const cv::Vec3f mean = 0.25f * (at(40, 30) + at(41, 30) + at(40, 31) + at(41, 31));
+  CHECK(value == doctest::Approx(mean[0]).epsilon(1e-6));
+  CHECK(du == doctest::Approx(mean[1]).epsilon(1e-6));
+  CHECK(dv == doctest::Approx(mean[2]).epsilon(1e-6));
+  // A grid's cells: those where the image is defined, each with its pixel's intensity.
+  bt::SurfaceGrid grid;
+  grid.step = 4;
+  for (int y = 0; y < 25; ++y)
+    for (int x = 0; x < 30; ++x)
+      if (mask.at<uchar>(4 * y, 4 * x)) grid.cells.emplace_back(x, y);
+  bt::IntensityImage sampled = image;
+  sampled.sampleCells(grid);
+  std::size_t next = 0;
+  for (std::size_t k = 0; k < grid.cells.size(); ++k) {
+    const int u = 4 * grid.cells[k].x, v = 4 * grid.cells[k].y;
+    if (!image.sample(u, v, value, du, dv)) continue;
+    REQUIRE(next < sampled.cells.size());
+    CHECK(sampled.cells[next].cell == int(k));
+    CHECK(sampled.cells[next].intensity == at(u, v)[0]);
+    ++next;
+  }
+  CHECK(next == sampled.cells.size());
+  CHECK(next > 200);
 }

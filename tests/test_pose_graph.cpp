@@ -72,12 +72,12 @@ bt::Keyframe surfaceKeyframe(int id, const bt::SE3d& T_cam_obj, const bt::Pinhol
   // Brightness linear in the pixel, so that bilinear sampling is exact and its derivatives are the
   // image's: the residual's dependence on the poses is then all in the projection.
   k.image.box = cv::Rect(0, 0, 80, 60);
-  k.image.intensity.create(60, 80, CV_32FC1);
+  k.image.samples.create(60, 80, CV_32FC3);
   for (int v = 0; v < 60; ++v)
-    for (int u = 0; u < 80; ++u) k.image.intensity.at<float>(v, u) = 0.3f + 0.004f * float(u) + 0.003f * float(v) + 0.01f * float(id);
-  k.image.d_u = cv::Mat(60, 80, CV_32FC1, cv::Scalar(0.004));
-  k.image.d_v = cv::Mat(60, 80, CV_32FC1, cv::Scalar(0.003));
+    for (int u = 0; u < 80; ++u)
+      k.image.samples.at<cv::Vec3f>(v, u) = {0.3f + 0.004f * float(u) + 0.003f * float(v) + 0.01f * float(id), 0.004f, 0.003f};
   k.image.valid = cv::Mat(60, 80, CV_8UC1, cv::Scalar(255));
+  k.image.sampleCells(k.surface);
   return k;
 }
 

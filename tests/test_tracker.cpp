@@ -137,6 +137,29 @@ TEST_CASE("brightness keeps a small textured mug's turn at 2 m where its surface
   CHECK(brightness_deg < 0.6 * surface_deg);
 }
 
+TEST_CASE("keyframes carry an intensity image only where a term of the energy reads one") {
+  using Features = bt::Term<bt::FeaturePointToPoint, bt::HuberLoss>;
+  CHECK(bt::DefaultEnergy().readsImages());
+  CHECK_FALSE(bt::Energy<Features>().readsImages());
+  bt::DefaultEnergy without;
+  std::get<2>(without.terms).weight = 0.0;
+  CHECK_FALSE(without.readsImages());
+  synth::SyntheticSequenceSettings settings;
+  settings.frames = 2;
+  const synth::SyntheticScene scene(settings);
+  const auto camera = settings.camera.cast<float>();
+  const synth::SyntheticFrame f = scene.frame(0);
+  const bt::RgbdFrame frame = bt::makeFrame("0", f.color, f.depth, f.mask, camera);
+  bt::DefaultTracker with_term(camera), without_term(camera, {}, without);
+  with_term.initialize(frame, f.T_cam_obj);
+  without_term.initialize(frame, f.T_cam_obj);
+  const bt::Keyframe& first = with_term.keyframes()[0];
+  CHECK_FALSE(first.image.empty());
+  CHECK(first.image.cells.size() > first.surface.cells.size() / 2);
+  CHECK(without_term.keyframes()[0].image.empty());
+  CHECK(without_term.keyframes()[0].surface.cells.size() == first.surface.cells.size());
+}
+
 TEST_CASE("from the first mask alone: propagated masks track the hand-held box as well as given masks" * doctest::test_suite("end_to_end")) {
   synth::SyntheticSequenceSettings settings;
   settings.frames = 60;

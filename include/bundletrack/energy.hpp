@@ -84,6 +84,17 @@ struct Energy {
   };
 
   Problem over(const PoseGraph& graph) const { return Problem(*this, graph); }
+
+  /// Whether a term of non-zero weight reads the keyframes' intensity images (its residual says
+  /// so: `static constexpr bool kReadsImages = true`); without one the tracker builds none.
+  bool readsImages() const {
+    return std::apply([](const Terms&... term) { return (... || (readsImagesOf<typename Terms::ResidualType> && term.weight != 0.0)); },
+                      terms);
+  }
+
+ private:
+  template <typename R>
+  static constexpr bool readsImagesOf = requires { requires R::kReadsImages; };
 };
 
 /// What the tracker asks of its energy: a Gauss-Newton problem over each frame's pose graph.

@@ -73,7 +73,7 @@ class Tracker {
     cache_.clear();
     frame_index_ = 0;
     lost_streak_ = 0;
-    pool_.add(makeKeyframe(0, masked, masked.mask, features, T_cam_obj, camera_, grid_step_));
+    pool_.add(keyframeOf(0, masked, masked.mask, features, T_cam_obj));
     result.keypoints = int(features.size());
     last_ = LastGood{0, T_cam_obj, pool_[0].surface, {0, T_cam_obj, std::move(features)}};
     result.T_cam_obj = T_cam_obj;
@@ -332,11 +332,18 @@ class Tracker {
     return true;
   }
 
+  /// A frame as a graph node on the tracker's grid, with an intensity image unless no term of the
+  /// energy reads one.
+  Keyframe keyframeOf(int id, const RgbdFrame& frame, const cv::Mat& mask, FrameFeatures features, const SE3d& T_cam_obj) const {
+    bool with_image = true;
+    if constexpr (requires { energy_.readsImages(); }) with_image = energy_.readsImages();
+    return makeKeyframe(id, frame, mask, std::move(features), T_cam_obj, camera_, grid_step_, with_image);
+  }
+
   /// The current frame as a graph node at its coarse pose, with its features.
   const Keyframe& makeNode(FrameContext& ctx) {
     clock_.enter(&StageTimings::graph);
-    return ctx.current = makeKeyframe(ctx.id, ctx.masked, ctx.masked.mask, std::move(ctx.features),
-                                      ctx.coarse.T_cam_obj, camera_, grid_step_);
+    return ctx.current = keyframeOf(ctx.id, ctx.masked, ctx.masked.mask, std::move(ctx.features), ctx.coarse.T_cam_obj);
   }
 
   /// Paper IV-C, IV-D: the current frame and the keyframes selected for its coarse pose, all pairs.
@@ -391,8 +398,7 @@ class Tracker {
     if (refined.data == ctx.masked.mask.data || cv::countNonZero(refined) == 0) return;
     ctx.masked.mask = ctx.result.mask = refined;
     keepFeaturesInside(ctx.current.features, refined);
-    ctx.current = makeKeyframe(ctx.id, ctx.masked, refined, std::move(ctx.current.features), ctx.result.T_cam_obj,
-                               camera_, grid_step_);
+    ctx.current = keyframeOf(ctx.id, ctx.masked, refined, std::move(ctx.current.features), ctx.result.T_cam_obj);
   }
 
   /// Paper IV-E: the frame joins the pool when it shows a novel view (a copy only then: the graph

@@ -1,9 +1,12 @@
 #pragma once
 
 #include <cmath>
+#include <vector>
 
 #include <opencv2/core.hpp>
 #include <opencv2/imgproc.hpp>
+
+#include "bundletrack/core/surface_grid.hpp"
 
 namespace bundletrack {
 
@@ -16,11 +19,18 @@ namespace bundletrack {
 /// the derivatives see object pixels alone, so the background never enters.
 struct IntensityImage {
   static constexpr double kLocalMeanSigma = 3.0;  ///< pixels
-  cv::Mat intensity, d_u, d_v;  ///< CV_32FC1, box.size()
+  cv::Mat samples;  ///< CV_32FC3, box.size(): intensity and its derivatives along u and v, side by side
   cv::Mat valid;  ///< CV_8UC1, box.size(): non-zero where intensity and derivatives are defined
   cv::Rect box;
+  /// A cell of the keyframe's surface grid (its index in SurfaceGrid::cells) where the image is
+  /// defined, with the intensity there: what the photometric term reads of its source frame.
+  struct CellIntensity {
+    int cell;
+    float intensity;
+  };
+  std::vector<CellIntensity> cells;  ///< in the grid's cell order (sampleCells)
 
-  bool empty() const { return intensity.empty(); }
+  bool empty() const { return samples.empty(); }
 
   /// Bilinear intensity and derivatives at full-resolution pixel (u, v) (centres at integers);
   /// false where the four neighbours are not all valid.
@@ -32,13 +42,25 @@ struct IntensityImage {
     const uchar* m1 = valid.ptr<uchar>(y0 + 1) + x0;
     if (!(m0[0] && m0[1] && m1[0] && m1[1])) return false;
     const double a = x - x0, b = y - y0;
-    const auto mix = [&](const cv::Mat& m) {
-      const float* r0 = m.ptr<float>(y0) + x0;
-      const float* r1 = m.ptr<float>(y0 + 1) + x0;
-      return (1 - b) * ((1 - a) * r0[0] + a * r0[1]) + b * ((1 - a) * r1[0] + a * r1[1]);
+    const cv::Vec3f* r0 = samples.ptr<cv::Vec3f>(y0) + x0;
+    const cv::Vec3f* r1 = samples.ptr<cv::Vec3f>(y0 + 1) + x0;
+    const auto mix = [&](int c) {
+      return (1 - b) * ((1 - a) * r0[0][c] + a * r0[1][c]) + b * ((1 - a) * r1[0][c] + a * r1[1][c]);
     };
-    value = mix(intensity), du = mix(d_u), dv = mix(d_v);
+    value = mix(0), du = mix(1), dv = mix(2);
     return true;
+  }
+
+  /// Fills `cells` from the grid's cells (full-resolution pixel step x cell), where the image is
+  /// defined. The sample sits on a pixel centre, so it is that pixel's intensity.
+  void sampleCells(const SurfaceGrid& grid) {
+    cells.clear();
+    if (empty()) return;
+    for (std::size_t k = 0; k < grid.cells.size(); ++k) {
+      double value = 0.0, du = 0.0, dv = 0.0;
+      if (sample(grid.step * grid.cells[k].x, grid.step * grid.cells[k].y, value, du, dv))
+        cells.push_back({int(k), float(value)});
+    }
   }
 };
 
@@ -62,9 +84,11 @@ inline IntensityImage makeIntensityImage(const cv::Mat& bgr, const cv::Mat& mask
   const cv::Size window(2 * int(std::ceil(3 * s)) + 1, 2 * int(std::ceil(3 * s)) + 1);
   cv::GaussianBlur(smooth.mul(on_object), weighted, window, s, s, cv::BORDER_CONSTANT);
   cv::GaussianBlur(on_object, coverage, window, s, s, cv::BORDER_CONSTANT);
-  image.intensity = smooth - weighted / cv::max(coverage, 1e-6);
-  cv::Sobel(image.intensity, image.d_u, CV_32F, 1, 0, 3, 1.0 / 8.0, 0.0, cv::BORDER_REPLICATE);
-  cv::Sobel(image.intensity, image.d_v, CV_32F, 0, 1, 3, 1.0 / 8.0, 0.0, cv::BORDER_REPLICATE);
+  const cv::Mat intensity = smooth - weighted / cv::max(coverage, 1e-6);
+  cv::Mat d_u, d_v;
+  cv::Sobel(intensity, d_u, CV_32F, 1, 0, 3, 1.0 / 8.0, 0.0, cv::BORDER_REPLICATE);
+  cv::Sobel(intensity, d_v, CV_32F, 0, 1, 3, 1.0 / 8.0, 0.0, cv::BORDER_REPLICATE);
+  cv::merge(std::vector<cv::Mat>{intensity, d_u, d_v}, image.samples);
   cv::erode(mask(image.box), image.valid, cv::Mat(), {-1, -1}, 2, cv::BORDER_CONSTANT, cv::Scalar(0));
   return image;
 }

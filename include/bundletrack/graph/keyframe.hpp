@@ -21,13 +21,18 @@ struct Keyframe {
   IntensityImage image;
 };
 
-/// The keyframe of `frame` under `mask`, its surface sampled every `grid_step` pixels; its
-/// intensity image reaches two grid steps beyond the mask, as far as a point associated with the
-/// surface (within one cell of it) can project.
+/// The keyframe of `frame` under `mask`, its surface sampled every `grid_step` pixels. With
+/// `with_image` (an energy term reads it) its intensity image reaches two grid steps beyond the
+/// mask, as far as a point associated with the surface (within one cell of it) can project, and
+/// holds the intensity at the surface's cells.
 inline Keyframe makeKeyframe(int id, const RgbdFrame& frame, const cv::Mat& mask, FrameFeatures features,
-                             const SE3d& T_cam_obj, const PinholeCameraf& camera, int grid_step) {
-  return {id, frame.name, T_cam_obj, std::move(features), sampleSurface(frame, mask, camera, grid_step),
-          makeIntensityImage(frame.color, mask, 2 * grid_step)};
+                             const SE3d& T_cam_obj, const PinholeCameraf& camera, int grid_step, bool with_image = true) {
+  Keyframe keyframe{id, frame.name, T_cam_obj, std::move(features), sampleSurface(frame, mask, camera, grid_step), {}};
+  if (with_image) {
+    keyframe.image = makeIntensityImage(frame.color, mask, 2 * grid_step);
+    keyframe.image.sampleCells(keyframe.surface);
+  }
+  return keyframe;
 }
 
 }  // namespace bundletrack

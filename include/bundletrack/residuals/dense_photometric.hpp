@@ -24,6 +24,7 @@ namespace bundletrack {
 /// so brightness counts more where depth is noisier, and the term integrates over the surface at
 /// any grid step. Texture constrains what depth cannot: the turn of a surface of revolution.
 struct DensePhotometric {
+  static constexpr bool kReadsImages = true;  ///< keyframes need their IntensityImage (Energy::readsImages)
   SurfaceGate gate;  ///< the dense term's association gate (2 cm / 45 degrees)
   /// Intensity (0-1): the spread of one residual as the term weighs it. Far above a pixel's noise
   /// (~0.01): neighbouring residuals share the smoothing and the texture's sampling, and what the
@@ -68,9 +69,9 @@ struct DensePhotometric {
     // t's full-resolution camera: its grid's camera scaled back by the grid step.
     const double fx = double(t.camera.fx) * t.step, fy = double(t.camera.fy) * t.step;
     const double cx = double(t.camera.cx) * t.step, cy = double(t.camera.cy) * t.step;
-    for (const cv::Point& cell : s.cells) {
-      double brightness_s = 0.0, unused_u = 0.0, unused_v = 0.0;
-      if (!image_s.sample(s.step * cell.x, s.step * cell.y, brightness_s, unused_u, unused_v)) continue;
+    for (const IntensityImage::CellIntensity& sampled : image_s.cells) {
+      const cv::Point& cell = s.cells[std::size_t(sampled.cell)];
+      const double brightness_s = sampled.intensity;
       const cv::Vec3f& ps = s.points.at<cv::Vec3f>(cell);
       const Eigen::Vector3d p_s(ps[0], ps[1], ps[2]), q = T_t_s * p_s;
       int u = 0, v = 0;
