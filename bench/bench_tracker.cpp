@@ -19,6 +19,8 @@
 #include <string>
 #include <vector>
 
+#include "command_line.hpp"
+
 #include "bundletrack/io/read_ahead.hpp"
 #include "bundletrack/io/rgbd_sequence.hpp"
 #include "bundletrack/runtime/make_tracker.hpp"
@@ -176,31 +178,21 @@ void run(const std::string& name, const bt::PinholeCameraf& camera, std::size_t 
 
 int main(int argc, char** argv) {
   Options options;
-  const char* const usage =
-      "usage: bench_tracker [--sequence DIR ...] [--frames N] [--memory-every N] [--features sift|orb|akaze] [--gpu]\n";
-  for (int i = 1; i < argc; ++i) {
-    const std::string arg = argv[i];
-    if (arg == "--gpu") {
-      options.gpu = true;
-      continue;
-    }
-    if (arg == "--help" || arg == "-h") {
-      std::printf("%s", usage);
-      return 0;
-    }
-    if (i + 1 >= argc) {
-      std::fprintf(stderr, "%s needs a value\n%s", arg.c_str(), usage);
-      return 2;
-    }
-    if (arg == "--sequence") options.sequences.emplace_back(argv[++i]);
-    else if (arg == "--frames") options.frames = std::atoi(argv[++i]);
-    else if (arg == "--memory-every") options.memory_every = std::atoi(argv[++i]);
-    else if (arg == "--features") options.features = argv[++i];
-    else {
-      std::fprintf(stderr, "unknown option '%s'\n%s", arg.c_str(), usage);
-      return 2;
-    }
-  }
+  bt::examples::CommandLine command_line(
+      "The default tracker's time per stage (medians and 90th percentiles) on sequences from files, or on\n"
+      "the synthetic hand-held box rendered in memory.",
+      "bench_tracker");
+  command_line.add_option("--sequence", options.sequences, "a sequence directory (repeatable; none: the synthetic box)")
+      ->type_name("DIR");
+  command_line.add_option("--frames", options.frames, "frames of the synthetic box")->capture_default_str()->check(bt::examples::wholeAtLeast(1));
+  command_line.add_option("--memory-every", options.memory_every, "report resident memory every N frames (0: no memory report)")
+      ->capture_default_str()
+      ->check(bt::examples::wholeAtLeast(0));
+  command_line.add_option("--features", options.features, "sift | orb | akaze")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"sift", "orb", "akaze"}));
+  command_line.add_flag("--gpu", options.gpu, "also the GPU-composed tracker on the same frames");
+  command_line.parseOrExit(argc, argv);
   const int frames = options.frames;
   try {
     if (options.sequences.empty()) {

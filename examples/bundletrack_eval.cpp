@@ -16,6 +16,8 @@
 #include <optional>
 #include <string>
 
+#include "command_line.hpp"
+
 #include "bundletrack/eval/score_table.hpp"
 #include "bundletrack/io/image_files.hpp"
 #include "bundletrack/io/point_files.hpp"
@@ -27,9 +29,6 @@ namespace bt = bundletrack;
 namespace fs = std::filesystem;
 
 namespace {
-
-const char* const kUsage =
-    "usage: bundletrack_eval --sequence DIR --poses DIR [--sequence DIR --poses DIR ...] [--json FILE] [--in-view]\n";
 
 /// Whether each frame of track.csv (columns frame,status,...) was reported lost; none without the file.
 std::optional<std::map<std::string, bool>> lostFrames(const fs::path& csv) {
@@ -106,35 +105,24 @@ Scored evaluate(const fs::path& sequence_dir, const fs::path& poses_dir, bool in
 }  // namespace
 
 int main(int argc, char** argv) {
-  std::vector<fs::path> sequences, poses;
-  fs::path json;
+  std::vector<std::string> sequences, poses;
+  std::string json;
   bool in_view = false;
-  for (int i = 1; i < argc; ++i) {
-    const std::string arg = argv[i];
-    if (arg == "--help" || arg == "-h") {
-      std::cout << kUsage;
-      return 0;
-    }
-    if (arg == "--in-view") {
-      in_view = true;
-      continue;
-    }
-    if (i + 1 >= argc) {
-      std::cerr << "error: " << arg << " needs a value\n" << kUsage;
-      return 2;
-    }
-    if (arg == "--sequence") sequences.emplace_back(argv[++i]);
-    else if (arg == "--poses") poses.emplace_back(argv[++i]);
-    else if (arg == "--json") json = argv[++i];
-    else {
-      std::cerr << "error: unknown option '" << arg << "'\n" << kUsage;
-      return 2;
-    }
-  }
-  if (sequences.empty() || sequences.size() != poses.size()) {
-    std::cerr << "error: give one --poses for every --sequence\n" << kUsage;
-    return 2;
-  }
+  bt::examples::CommandLine command_line(
+      "Scores pose files (POSES/<frame>.txt, 4x4 T_cam_obj) against each sequence's annotated_poses/ and\n"
+      "model/points.xyz: one row per sequence and their mean. A frame without a pose file is a failure.",
+      "bundletrack_eval");
+  command_line.add_option("--sequence", sequences, "a sequence directory (give one --poses for each, in the same order)")
+      ->type_name("DIR")
+      ->required();
+  command_line.add_option("--poses", poses, "the poses of the --sequence at the same position (OUT/poses of bundletrack_track);\n"
+                                            "with OUT/track.csv beside it, lost frames are also scored as failures")
+      ->type_name("DIR")
+      ->required();
+  command_line.add_option("--json", json, "also write the scores as JSON to FILE")->type_name("FILE");
+  command_line.add_flag("--in-view", in_view, "score only the frames whose masks/<frame>.png has a pixel on the object");
+  command_line.parseOrExit(argc, argv);
+  if (sequences.size() != poses.size()) command_line.fail("give one --poses for every --sequence");
   try {
     std::vector<bt::NamedScore> rows, lost_as_failed;
     int unscored = 0, out_of_view = 0;

@@ -1,4 +1,4 @@
-// bundletrack_inspect --sequence DIR [--depth-scale S] [--overlay DIR [--every N]]
+// bundletrack_inspect --sequence DIR [--depth-scale S] [--overlay DIR [--every N]] (--help: the options)
 // Loads and preprocesses every frame of a YCBInEOAT-layout sequence and prints what the tracker
 // will see: object mask area, how much of it has depth before and after filtering, normals,
 // object depth and the preprocessing time per frame. --overlay writes every N-th frame with the
@@ -8,6 +8,8 @@
 #include <cstdio>
 #include <iostream>
 #include <string>
+
+#include "command_line.hpp"
 
 #include "bundletrack/io/rgbd_sequence.hpp"
 #include "bundletrack/viz/overlay.hpp"
@@ -32,32 +34,26 @@ void writeOverlay(const std::filesystem::path& dir, const bt::io::RgbdSequence& 
   if (!cv::imwrite(path.string(), image)) throw bt::InputError(path, "cannot write image");
 }
 
-int usage(const char* program) {
-  std::cerr << "usage: " << program << " --sequence DIR [--depth-scale METRES_PER_UNIT] [--overlay DIR [--every N]]\n";
-  return 2;
-}
-
 }  // namespace
 
 int main(int argc, char** argv) {
   std::string sequence_dir, overlay_dir;
   int every = 10;
   bt::io::SequenceSettings settings;
-  for (int i = 1; i < argc; ++i) {
-    const std::string arg = argv[i];
-    if (arg == "--sequence" && i + 1 < argc) {
-      sequence_dir = argv[++i];
-    } else if (arg == "--overlay" && i + 1 < argc) {
-      overlay_dir = argv[++i];
-    } else if (arg == "--every" && i + 1 < argc) {
-      every = std::max(1, std::stoi(argv[++i]));
-    } else if (arg == "--depth-scale" && i + 1 < argc) {
-      settings.depth_scale = std::stod(argv[++i]);
-    } else {
-      return usage(argv[0]);
-    }
-  }
-  if (sequence_dir.empty()) return usage(argv[0]);
+  bt::examples::CommandLine command_line(
+      "Loads and preprocesses every frame of a sequence and prints what the tracker will see: mask area,\n"
+      "depth before and after filtering, normals, object depth, preprocessing time per frame.",
+      "bundletrack_inspect");
+  command_line.add_option("--sequence", sequence_dir, "the sequence directory (YCBInEOAT or TUM RGB-D layout)")
+      ->type_name("DIR")
+      ->required();
+  command_line.add_option("--depth-scale", settings.depth_scale, "metres per unit of the depth images (default: the layout's)")
+      ->type_name("S")
+      ->check(bt::examples::positive());
+  command_line.add_option("--overlay", overlay_dir, "write frames with the annotated pose's axes and the mask outline to DIR")
+      ->type_name("DIR");
+  command_line.add_option("--every", every, "with --overlay: every N-th frame")->capture_default_str()->check(bt::examples::wholeAtLeast(1));
+  command_line.parseOrExit(argc, argv);
 
   try {
     const bt::io::RgbdSequence sequence(sequence_dir, settings);

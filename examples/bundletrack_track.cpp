@@ -22,6 +22,8 @@
 
 #include <opencv2/videoio.hpp>
 
+#include "command_line.hpp"
+
 #include "bundletrack/config/config_file.hpp"
 #include "bundletrack/eval/mask_iou.hpp"
 #include "bundletrack/eval/pose_metrics.hpp"
@@ -39,67 +41,26 @@ namespace fs = std::filesystem;
 
 namespace {
 
-const char* const kUsage = R"(usage: bundletrack_track --sequence DIR --out DIR [options]
-  --config FILE      YAML settings over the defaults (see --print-config); options below override it
-  --print-config     print the effective configuration as YAML and exit
-  --print-config-table  print every setting with its default as a Markdown table and exit
-  --features F       sift | orb | akaze (sift)
-  --tracker T        full: pose graph over keyframes (paper IV) | coarse: frame-to-frame RANSAC only (full)
-  --depth-scale S    metres per unit of the depth images (the layout's: 0.001 YCBInEOAT, 1/5000 TUM)
-  --min-inliers N    fewest RANSAC inliers that count as a pose; fewer: the frame is lost (5)
-  --inlier-mm D      RANSAC inlier distance in millimetres (5; widened by the sensor's noise)
-  --sensor S         structured_light (Kinect v1, Xtion) | active_stereo (RealSense D4xx) |
-                     time_of_flight (Azure Kinect): the depth noise every depth tolerance widens
-                     with (sensor.model; structured_light); loads the preset's numbers over any
-                     sensor.* of --config (refine a preset with sensor.* keys in the file)
-  --gpu              matching, dense term, PCG and RANSAC on a CUDA device (compute.device: gpu;
-                     needs a build with the CUDA backend and a GPU; keypoints stay on the CPU)
-  --propagate-masks  the tracker gets only the first frame's mask and follows the object from it
-                     (masks.source: propagated); later masks, where the sequence has them, are
-                     read only to report each propagated mask's IoU in track.csv and a summary;
-                     the masks used go to OUT/masks/<frame>.png
-  --viz              write OUT/overlay.mp4 (pose axes, object box, mask outline per frame; an image
-                     strip OUT/overlay_strip.png always, and in place of the video where no encoder
-                     is available) and, with ground truth, OUT/errors.png (errors over time)
-  --strict           a later frame that cannot be read (file missing or undecodable, depth without
-                     a reading, no mask with given masks, no annotated pose) stops the run; by
-                     default it is reported lost with the reason (track.csv: problem) and the run
-                     goes on, the frame scored as a failure (without an annotated pose: not scored)
-  --objects LIST     a sequence of several objects (masks/<object>/<frame>.png, one folder per
-                     object, or label images labels/<frame>.png named by labels/objects.txt;
-                     annotated_poses/<object>/ and model/<object>/ likewise): the objects
-                     to track, names separated by commas, or all (all). Each is tracked by its own
-                     tracker from the first frame with a non-empty mask of it, at its annotated pose
-                     there (else the identity), the frames read and preprocessed once for all of
-                     them; the outputs go to OUT/<object>/ (poses/, track.csv, model.ply,
-                     errors.png), the overlay shows them all
-  --quiet            no progress line
-)";
-
-[[noreturn]] void fail(const std::string& message) {
-  std::cerr << "error: " << message << "\n" << kUsage;
-  std::exit(2);
-}
-
 /// Sets the choice setting `key` to `name` as a command-line option asks; an unknown name fails.
-void setChoice(bt::Config& config, const std::string& key, const std::string& option, const std::string& name) {
+void setChoice(const bt::examples::CommandLine& command_line, bt::Config& config, const std::string& key,
+               const std::string& option, const std::string& name) {
   for (const bt::ConfigEntry& entry : bt::configEntries(config)) {
     if (entry.name() != key) continue;
     const auto& choice = std::get<bt::ConfigChoice>(entry.value);
     if (std::find(choice.names.begin(), choice.names.end(), name) == choice.names.end())
-      fail(option + " '" + name + "': expected " + choice.alternatives());
+      command_line.fail(option + " '" + name + "': expected " + choice.alternatives());
     choice.set(name);
   }
 }
 
-double number(const std::string& option, const std::string& text) {
+double number(const bt::examples::CommandLine& command_line, const std::string& option, const std::string& text) {
   try {
     std::size_t used = 0;
     const double value = std::stod(text, &used);
     if (used == text.size() && std::isfinite(value)) return value;
   } catch (const std::exception&) {
   }
-  fail(option + " expects a number, got '" + text + "'");
+  command_line.fail(option + " expects a number, got '" + text + "'");
 }
 
 struct Options {
@@ -119,7 +80,7 @@ std::vector<std::string> chosenObjects(const bt::io::RgbdSequence& sequence, con
   for (const std::string& name : available) names += (names.empty() ? "" : ", ") + name;
   if (available.empty()) {
     if (!list.empty())
-      fail("--objects " + list + ": " + (sequence.root() / "masks").string() +
+      throw std::invalid_argument("--objects " + list + ": " + (sequence.root() / "masks").string() +
            " holds the masks of one object (masks/<frame>.png), not a folder per object nor label images");
     return {""};
   }
@@ -128,11 +89,11 @@ std::vector<std::string> chosenObjects(const bt::io::RgbdSequence& sequence, con
   std::stringstream items(list);
   for (std::string name; std::getline(items, name, ',');) {
     if (std::find(available.begin(), available.end(), name) == available.end())
-      fail("--objects: no object '" + name + "' in " + sequence.objectList().string() + " (it has " + names + ")");
-    if (std::find(chosen.begin(), chosen.end(), name) != chosen.end()) fail("--objects names '" + name + "' twice");
+      throw std::invalid_argument("--objects: no object '" + name + "' in " + sequence.objectList().string() + " (it has " + names + ")");
+    if (std::find(chosen.begin(), chosen.end(), name) != chosen.end()) throw std::invalid_argument("--objects names '" + name + "' twice");
     chosen.push_back(name);
   }
-  if (chosen.empty()) fail("--objects needs at least one name (it has " + names + ")");
+  if (chosen.empty()) throw std::invalid_argument("--objects needs at least one name (it has " + names + ")");
   return chosen;
 }
 
@@ -566,47 +527,86 @@ void writeText(const fs::path& path, const std::string& text) { std::ofstream(pa
 int main(int argc, char** argv) {
   Options options;
   fs::path incomplete;  // OUT/INCOMPLETE once the output exists
-  bool print_config = false;
-  std::vector<std::pair<std::string, std::string>> overrides;
-  for (int i = 1; i < argc; ++i) {
-    const std::string arg = argv[i];
-    const auto value = [&]() -> std::string {
-      if (i + 1 >= argc) fail(arg + " needs a value");
-      return argv[++i];
-    };
-    if (arg == "--sequence") options.sequence = value();
-    else if (arg == "--out") options.out = value();
-    else if (arg == "--tracker") overrides.emplace_back(arg, value());
-    else if (arg == "--config") options.config_file = value();
-    else if (arg == "--print-config") print_config = true;
-    else if (arg == "--print-config-table") {
-      std::cout << bt::settingsTable();
-      return 0;
-    }
-    else if (arg == "--features" || arg == "--depth-scale" || arg == "--min-inliers" || arg == "--inlier-mm" ||
-             arg == "--sensor")
-      overrides.emplace_back(arg, value());
-    else if (arg == "--propagate-masks" || arg == "--gpu") overrides.emplace_back(arg, "");
-    else if (arg == "--objects") options.objects = value();
-    else if (arg == "--quiet") options.quiet = true;
-    else if (arg == "--strict") options.strict = true;
-    else if (arg == "--viz") options.viz = true;
-    else if (arg == "--help" || arg == "-h") {
-      std::cout << kUsage;
-      return 0;
-    } else fail("unknown option '" + arg + "'");
+  bool print_config = false, print_config_table = false, propagate_masks = false, gpu = false;
+  std::string sequence, out, config_file;
+  // Options that set a configuration key: applied over --config in this order (each may be given once).
+  std::vector<std::pair<std::string, std::string>> overrides = {
+      {"--tracker", ""}, {"--features", ""}, {"--depth-scale", ""}, {"--min-inliers", ""}, {"--inlier-mm", ""}, {"--sensor", ""}};
+  const auto value_of = [&](const std::string& option) -> std::string& {
+    return std::find_if(overrides.begin(), overrides.end(), [&](const auto& entry) { return entry.first == option; })->second;
+  };
+  bt::examples::CommandLine command_line(
+      "Tracks the 6D pose of an object through an RGB-D sequence (BundleTrack, online and causal) from its\n"
+      "first frame's mask and pose; writes OUT/poses/<frame>.txt (4x4 T_cam_obj), OUT/track.csv and\n"
+      "OUT/model.ply, and scores the poses where the sequence has ground truth.",
+      "bundletrack_track");
+  command_line.add_option("--sequence", sequence, "the sequence directory (YCBInEOAT or TUM RGB-D layout)")->type_name("DIR");
+  command_line.add_option("--out", out, "the output directory (created; its poses/ and masks/ are replaced)")->type_name("DIR");
+  command_line.add_option("--config", config_file, "YAML settings over the defaults (see --print-config); options below override it")
+      ->type_name("FILE");
+  command_line.add_flag("--print-config", print_config, "print the effective configuration as YAML and exit");
+  command_line.add_flag("--print-config-table", print_config_table, "print every setting with its default as a Markdown table and exit");
+  command_line.add_option("--features", value_of("--features"), "sift | orb | akaze (sift)")->type_name("F");
+  command_line.add_option("--tracker", value_of("--tracker"),
+                          "full: pose graph over keyframes (paper IV) | coarse: frame-to-frame RANSAC only (full)")
+      ->type_name("T");
+  command_line.add_option("--depth-scale", value_of("--depth-scale"),
+                          "metres per unit of the depth images (the layout's: 0.001 YCBInEOAT, 1/5000 TUM)")
+      ->type_name("S");
+  command_line.add_option("--min-inliers", value_of("--min-inliers"), "fewest RANSAC inliers that count as a pose; fewer: the frame is lost (5)")
+      ->type_name("N");
+  command_line.add_option("--inlier-mm", value_of("--inlier-mm"), "RANSAC inlier distance in millimetres (5; widened by the sensor's noise)")
+      ->type_name("D");
+  command_line.add_option("--sensor", value_of("--sensor"),
+                          "structured_light (Kinect v1, Xtion) | active_stereo (RealSense D4xx) |\n"
+                          "time_of_flight (Azure Kinect): the depth noise every depth tolerance widens\n"
+                          "with (sensor.model; structured_light); loads the preset's numbers over any\n"
+                          "sensor.* of --config (refine a preset with sensor.* keys in the file)")
+      ->type_name("S");
+  command_line.add_flag("--gpu", gpu, "matching, dense term, PCG and RANSAC on a CUDA device (compute.device: gpu;\n"
+                                      "needs a build with the CUDA backend and a GPU; keypoints stay on the CPU)");
+  command_line.add_flag("--propagate-masks", propagate_masks,
+                        "the tracker gets only the first frame's mask and follows the object from it\n"
+                        "(masks.source: propagated); later masks, where the sequence has them, are\n"
+                        "read only to report each propagated mask's IoU in track.csv and a summary;\n"
+                        "the masks used go to OUT/masks/<frame>.png");
+  command_line.add_flag("--viz", options.viz, "write OUT/overlay.mp4 (pose axes, object box, mask outline per frame; an image\n"
+                                              "strip OUT/overlay_strip.png always, and in place of the video where no encoder\n"
+                                              "is available) and, with ground truth, OUT/errors.png (errors over time)");
+  command_line.add_flag("--strict", options.strict, "a later frame that cannot be read (file missing or undecodable, depth without\n"
+                                                    "a reading, no mask with given masks, no annotated pose) stops the run; by\n"
+                                                    "default it is reported lost with the reason (track.csv: problem) and the run\n"
+                                                    "goes on, the frame scored as a failure (without an annotated pose: not scored)");
+  command_line.add_option("--objects", options.objects, "a sequence of several objects (masks/<object>/<frame>.png, one folder per\n"
+                                                        "object, or label images labels/<frame>.png named by labels/objects.txt;\n"
+                                                        "annotated_poses/<object>/ and model/<object>/ likewise): the objects\n"
+                                                        "to track, names separated by commas, or all (all). Each is tracked by its own\n"
+                                                        "tracker from the first frame with a non-empty mask of it, at its annotated pose\n"
+                                                        "there (else the identity), the frames read and preprocessed once for all of\n"
+                                                        "them; the outputs go to OUT/<object>/ (poses/, track.csv, model.ply,\n"
+                                                        "errors.png), the overlay shows them all")
+      ->type_name("LIST");
+  command_line.add_flag("--quiet", options.quiet, "no progress line");
+  command_line.parseOrExit(argc, argv);
+  if (print_config_table) {
+    std::cout << bt::settingsTable();
+    return 0;
   }
+  options.sequence = sequence, options.out = out, options.config_file = config_file;
+  if (propagate_masks) overrides.emplace_back("--propagate-masks", "");
+  if (gpu) overrides.emplace_back("--gpu", "");
   try {
     if (!options.config_file.empty()) options.config = bt::loadConfig(options.config_file);
     auto& config = options.config;
     for (const auto& [option, text] : overrides) {
+      if (text.empty() && option != "--propagate-masks" && option != "--gpu") continue;  // not given
       if (option == "--tracker") config.tracker = text;
       else if (option == "--features") config.features = text;
-      else if (option == "--depth-scale") bt::setNumber(config, "depth.scale", number(option, text), option + " " + text);
-      else if (option == "--min-inliers") bt::setNumber(config, "ransac.min_inliers", number(option, text), option + " " + text);
+      else if (option == "--depth-scale") bt::setNumber(config, "depth.scale", number(command_line, option, text), option + " " + text);
+      else if (option == "--min-inliers") bt::setNumber(config, "ransac.min_inliers", number(command_line, option, text), option + " " + text);
       else if (option == "--inlier-mm")
-        bt::setNumber(config, "ransac.inlier_distance", number(option, text) * 1e-3, option + " " + text);
-      else if (option == "--sensor") setChoice(config, "sensor.model", option, text);
+        bt::setNumber(config, "ransac.inlier_distance", number(command_line, option, text) * 1e-3, option + " " + text);
+      else if (option == "--sensor") setChoice(command_line, config, "sensor.model", option, text);
       else if (option == "--propagate-masks") config.masks = "propagated";
       else if (option == "--gpu") config.device = "gpu";
     }
@@ -615,7 +615,7 @@ int main(int argc, char** argv) {
       std::cout << bt::printConfig(config);
       return 0;
     }
-    if (options.sequence.empty() || options.out.empty()) fail("--sequence and --out are required");
+    if (options.sequence.empty() || options.out.empty()) command_line.fail("--sequence and --out are required");
     prepareOutput(options.out, {});
     const bt::io::RgbdSequence sequence(options.sequence, config.sequence);
     for (const std::string& caution : sequence.warnings()) std::cerr << "warning: " << caution << '\n';
@@ -632,7 +632,7 @@ int main(int argc, char** argv) {
     fs::remove(incomplete);
     return 0;
   } catch (const std::invalid_argument& error) {
-    fail(error.what());
+    command_line.fail(error.what());
   } catch (const std::exception& error) {
     std::cerr << "\nerror: " << error.what() << '\n';
     if (!incomplete.empty())

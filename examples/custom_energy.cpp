@@ -6,6 +6,8 @@
 #include <cstdio>
 #include <string>
 
+#include "command_line.hpp"
+
 #include "bundletrack/eval/sequence_score.hpp"
 #include "bundletrack/synth/synthetic_sequence.hpp"
 #include "bundletrack/default_tracker.hpp"
@@ -40,7 +42,11 @@ void run(const char* label, Tracker tracker, const bt::synth::SyntheticScene& sc
 
 int main(int argc, char** argv) {
   bt::synth::SyntheticSequenceSettings settings;
-  settings.frames = argc == 3 && std::string(argv[1]) == "--frames" ? std::atoi(argv[2]) : 60;
+  settings.frames = 60;
+  bt::examples::CommandLine command_line("Tracks the synthetic hand-held box with two energies composed at compile time.",
+                                         "custom_energy");
+  command_line.add_option("--frames", settings.frames, "frames of the synthetic box")->capture_default_str()->check(bt::examples::wholeAtLeast(1));
+  command_line.parseOrExit(argc, argv);
   settings.speed = 2.0;
   const bt::synth::SyntheticScene scene(settings);
   const auto camera = settings.camera.cast<float>();
