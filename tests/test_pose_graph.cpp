@@ -12,6 +12,7 @@
 #include "bundletrack/graph/relocalisation.hpp"
 #include "bundletrack/residuals/dense_photometric.hpp"
 #include "bundletrack/residuals/dense_point_to_plane.hpp"
+#include "bundletrack/residuals/dense_silhouette.hpp"
 #include "bundletrack/residuals/feature_point_to_point.hpp"
 #include "bundletrack/solvers/dense_ldlt.hpp"
 #include "bundletrack/solvers/gauss_newton.hpp"
@@ -78,6 +79,15 @@ bt::Keyframe surfaceKeyframe(int id, const bt::SE3d& T_cam_obj, const bt::Pinhol
       k.image.samples.at<cv::Vec3f>(v, u) = {0.3f + 0.004f * float(u) + 0.003f * float(v) + 0.01f * float(id), 0.004f, 0.003f};
   k.image.valid = cv::Mat(60, 80, CV_8UC1, cv::Scalar(255));
   k.image.sampleCells(k.surface);
+  // A signed distance likewise linear and positive (every point lands outside the silhouette),
+  // seen past by a far background: every point counts.
+  k.silhouette.box = k.image.box;
+  k.silhouette.samples.create(60, 80, CV_32FC3);
+  for (int v = 0; v < 60; ++v)
+    for (int u = 0; u < 80; ++u)
+      k.silhouette.samples.at<cv::Vec3f>(v, u) = {1.0f + 0.05f * float(u) - 0.02f * float(v) + 0.1f * float(id), 0.05f, -0.02f};
+  k.silhouette.depth = cv::Mat(60, 80, CV_32FC1, cv::Scalar(10.0));
+  for (const cv::Point& cell : k.surface.cells) k.silhouette.points.push_back(k.surface.points.at<cv::Vec3f>(cell));
   return k;
 }
 
@@ -135,7 +145,7 @@ TEST_CASE_TEMPLATE("robust losses match their formulas and rho' is the derivativ
   CHECK(bt::TukeyLoss{}.evaluate(0.02 * 0.02).d_rho == 0.0);
 }
 
-TEST_CASE("feature, dense and photometric residual Jacobians equal central differences of the residuals") {
+TEST_CASE("feature, dense, photometric and silhouette residual Jacobians equal central differences of the residuals") {
   std::mt19937 rng(3);
   const bt::PinholeCameraf grid{150.0f, 150.0f, 39.5f, 29.5f};
   const bt::SE3d T_i(bt::SO3d::exp(Eigen::Vector3d(2.8, 0.1, 0.0)), Eigen::Vector3d(0.0, 0.0, 0.6));
@@ -177,6 +187,12 @@ TEST_CASE("feature, dense and photometric residual Jacobians equal central diffe
   check(bt::FeaturePointToPoint{});
   check(bt::DensePointToPlane{});
   check(bt::DensePhotometric{});
+  // The silhouette term's weight follows how far a point's depth error moves it across the outline,
+  // which changes with the poses as a robust weight does and is held fixed in a step as one is;
+  // with a wide outline spread it is constant to 1e-9, and the differences test the Jacobian alone.
+  bt::DenseSilhouette silhouette;
+  silhouette.sigma = 1e3;
+  check(silhouette);
 }
 
 TEST_CASE("PCG and dense LDLT give the same update on a pose-graph system") {

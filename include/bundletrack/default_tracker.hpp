@@ -11,6 +11,7 @@
 #include "bundletrack/registration/ransac.hpp"
 #include "bundletrack/residuals/dense_photometric.hpp"
 #include "bundletrack/residuals/dense_point_to_plane.hpp"
+#include "bundletrack/residuals/dense_silhouette.hpp"
 #include "bundletrack/residuals/feature_point_to_point.hpp"
 #include "bundletrack/robust/losses.hpp"
 #include "bundletrack/solvers/pcg.hpp"
@@ -21,13 +22,17 @@
 namespace bundletrack {
 
 /// Paper eq. 1 with lambda_1 = lambda_2 = 1 and Huber losses (delta 5 mm), and the photometric
-/// term beside them (beyond the paper, docs/DESIGN.md section 7).
+/// and silhouette terms beside them (beyond the paper, docs/DESIGN.md section 7).
 /// Default-constructed, each term has its own default: the photometric term's Huber delta is in
-/// intensity (DensePhotometric::kHuberDelta), the others' 5 mm.
+/// intensity (DensePhotometric::kHuberDelta), the silhouette term's in pixels
+/// (DenseSilhouette::kHuberDelta), the others' 5 mm.
 template <typename Dense = DensePointToPlane>
-struct EnergyWithDense : Energy<Term<FeaturePointToPoint, HuberLoss>, Term<Dense, HuberLoss>, Term<DensePhotometric, HuberLoss>> {
-  using Base = Energy<Term<FeaturePointToPoint, HuberLoss>, Term<Dense, HuberLoss>, Term<DensePhotometric, HuberLoss>>;
-  EnergyWithDense() : Base{{{}, {}, {{}, HuberLoss{DensePhotometric::kHuberDelta}, 1.0}}} {}
+struct EnergyWithDense : Energy<Term<FeaturePointToPoint, HuberLoss>, Term<Dense, HuberLoss>, Term<DensePhotometric, HuberLoss>,
+                                Term<DenseSilhouette, HuberLoss>> {
+  using Base = Energy<Term<FeaturePointToPoint, HuberLoss>, Term<Dense, HuberLoss>, Term<DensePhotometric, HuberLoss>,
+                      Term<DenseSilhouette, HuberLoss>>;
+  EnergyWithDense()
+      : Base{{{}, {}, {{}, HuberLoss{DensePhotometric::kHuberDelta}, 1.0}, {{}, HuberLoss{DenseSilhouette::kHuberDelta}, 1.0}}} {}
   explicit EnergyWithDense(Base energy) : Base(std::move(energy)) {}
 };
 using DefaultEnergy = EnergyWithDense<>;

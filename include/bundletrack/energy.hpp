@@ -92,9 +92,17 @@ struct Energy {
                       terms);
   }
 
+  /// Likewise for the keyframes' silhouette images (`kReadsSilhouettes`).
+  bool readsSilhouettes() const {
+    return std::apply(
+        [](const Terms&... term) { return (... || (readsSilhouettesOf<typename Terms::ResidualType> && term.weight != 0.0)); }, terms);
+  }
+
  private:
   template <typename R>
   static constexpr bool readsImagesOf = requires { requires R::kReadsImages; };
+  template <typename R>
+  static constexpr bool readsSilhouettesOf = requires { requires R::kReadsSilhouettes; };
 };
 
 /// What the tracker asks of its energy: a Gauss-Newton problem over each frame's pose graph.

@@ -333,11 +333,13 @@ class Tracker {
   }
 
   /// A frame as a graph node on the tracker's grid, with an intensity image unless no term of the
-  /// energy reads one.
+  /// energy reads one, and a silhouette image where a term reads one and the masks outline the
+  /// object (GivenMasks::kOutlinesObject).
   Keyframe keyframeOf(int id, const RgbdFrame& frame, const cv::Mat& mask, FrameFeatures features, const SE3d& T_cam_obj) const {
-    bool with_image = true;
+    bool with_image = true, with_silhouette = requires { requires Masks::kOutlinesObject; };
     if constexpr (requires { energy_.readsImages(); }) with_image = energy_.readsImages();
-    return makeKeyframe(id, frame, mask, std::move(features), T_cam_obj, camera_, grid_step_, with_image);
+    if constexpr (requires { energy_.readsSilhouettes(); }) with_silhouette = with_silhouette && energy_.readsSilhouettes();
+    return makeKeyframe(id, frame, mask, std::move(features), T_cam_obj, camera_, grid_step_, with_image, with_silhouette);
   }
 
   /// The current frame as a graph node at its coarse pose, with its features.

@@ -34,14 +34,15 @@ inline RansacSettings ransacSettings(const Config& config) {
   return settings;
 }
 
-/// The default energy (paper eq. 1 and the photometric term) with a dense term of type Dense.
+/// The default energy (paper eq. 1, the photometric and silhouette terms) with a dense term of type Dense.
 template <typename Dense>
 EnergyWithDense<Dense> energy(const Config& config, Dense dense) {
   DensePhotometric photometric = config.photometric;
   photometric.gate = config.dense.gate;  // the dense term's association
   return EnergyWithDense<Dense>(
       {{Term<FeaturePointToPoint, HuberLoss>{{}, config.feature_loss, 1.0}, Term<Dense, HuberLoss>{std::move(dense), config.dense_loss, 1.0},
-        Term<DensePhotometric, HuberLoss>{photometric, config.photometric_loss, config.photometric_weight}},
+        Term<DensePhotometric, HuberLoss>{photometric, config.photometric_loss, config.photometric_weight},
+        Term<DenseSilhouette, HuberLoss>{config.silhouette, config.silhouette_loss, config.silhouette_weight}},
        config.execution});
 }
 

@@ -16,6 +16,7 @@
 #include "bundletrack/registration/ransac.hpp"
 #include "bundletrack/residuals/dense_photometric.hpp"
 #include "bundletrack/residuals/dense_point_to_plane.hpp"
+#include "bundletrack/residuals/dense_silhouette.hpp"
 #include "bundletrack/robust/losses.hpp"
 #include "bundletrack/solvers/pcg.hpp"
 #include "bundletrack/tracking/tracker_settings.hpp"
@@ -42,6 +43,9 @@ struct Config {
   DensePhotometric photometric;
   HuberLoss photometric_loss{DensePhotometric::kHuberDelta};
   double photometric_weight = 1.0;  ///< lambda of the photometric term (0: off)
+  DenseSilhouette silhouette;
+  HuberLoss silhouette_loss{DenseSilhouette::kHuberDelta};
+  double silhouette_weight = 1.0;  ///< lambda of the silhouette term (0: off)
   PCG pcg;
   std::string masks = "given";  ///< given | propagated
   PropagatedMaskSettings propagated_masks;
@@ -206,6 +210,9 @@ inline std::vector<ConfigEntry> configEntries(Config& c) {
       {"energy", "photometric_weight", &c.photometric_weight, 0.0, 1000.0, "", "lambda of the photometric term: brightness constancy of the surface points between frames (0: off)"},
       {"energy", "photometric_sigma", &c.photometric.sigma, 1e-4, 1.0, "", "expected brightness change of a surface point between views (intensity 0-1): the term's weight beside the depth noise"},
       {"energy", "photometric_huber_delta", &c.photometric_loss.delta, 1e-6, 1.0, "", "Huber delta of the photometric term (intensity 0-1)"},
+      {"energy", "silhouette_weight", &c.silhouette_weight, 0.0, 1000.0, "", "lambda of the silhouette term: every object point projects inside the object's mask in every frame (0: off)"},
+      {"energy", "silhouette_sigma", &c.silhouette.sigma, 1e-3, 100.0, "px", "spread of the masks' outlines: the term's weight beside the depth noise"},
+      {"energy", "silhouette_huber_delta", &c.silhouette_loss.delta, 1e-3, 100.0, "px", "Huber delta of the silhouette term"},
       {"solver", "step_control", enumChoice(t.gauss_newton.step_control, {{"none", StepControl::None}, {"levenberg_marquardt", StepControl::LevenbergMarquardt}}), 0, 0, "",
        "none: every Gauss-Newton step is taken (paper); levenberg_marquardt: damped, a step that raises the energy is rejected"},
       {"solver", "min_translation_step", &t.gauss_newton.min_translation_step, 0.0, 1.0, "m", "Gauss-Newton stops when no node moves more ..."},

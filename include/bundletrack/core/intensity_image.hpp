@@ -6,6 +6,7 @@
 #include <opencv2/core.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "bundletrack/core/bilinear.hpp"
 #include "bundletrack/core/surface_grid.hpp"
 
 namespace bundletrack {
@@ -35,20 +36,7 @@ struct IntensityImage {
   /// Bilinear intensity and derivatives at full-resolution pixel (u, v) (centres at integers);
   /// false where the four neighbours are not all valid.
   bool sample(double u, double v, double& value, double& du, double& dv) const {
-    const double x = u - box.x, y = v - box.y;
-    const int x0 = int(std::floor(x)), y0 = int(std::floor(y));
-    if (x0 < 0 || y0 < 0 || x0 + 1 >= box.width || y0 + 1 >= box.height) return false;
-    const uchar* m0 = valid.ptr<uchar>(y0) + x0;
-    const uchar* m1 = valid.ptr<uchar>(y0 + 1) + x0;
-    if (!(m0[0] && m0[1] && m1[0] && m1[1])) return false;
-    const double a = x - x0, b = y - y0;
-    const cv::Vec3f* r0 = samples.ptr<cv::Vec3f>(y0) + x0;
-    const cv::Vec3f* r1 = samples.ptr<cv::Vec3f>(y0 + 1) + x0;
-    const auto mix = [&](int c) {
-      return (1 - b) * ((1 - a) * r0[0][c] + a * r0[1][c]) + b * ((1 - a) * r1[0][c] + a * r1[1][c]);
-    };
-    value = mix(0), du = mix(1), dv = mix(2);
-    return true;
+    return sampleBilinear(samples, box, valid, u, v, value, du, dv);
   }
 
   /// Fills `cells` from the grid's cells (full-resolution pixel step x cell), where the image is

@@ -11,6 +11,10 @@ namespace bundletrack {
 /// Masks that come with the data (the frame's own mask, e.g. from masks/<name>.png): the same
 /// mask whatever the tracker knows.
 struct GivenMasks {
+  /// Each mask is the object's outline as the data sees it, independent of any pose: the
+  /// silhouette term may read it (a mask source without this flag makes no silhouettes).
+  static constexpr bool kOutlinesObject = true;
+
   /// The given mask's bounding box; the whole image without one (track() then reports it).
   cv::Rect regionOfInterest(cv::Size image, const cv::Mat& given_mask, const ObservedObject&,
                             const std::optional<SE3d>&) const {

@@ -6,6 +6,7 @@
 #include "bundletrack/core/intensity_image.hpp"
 #include "bundletrack/core/surface_gate.hpp"
 #include "bundletrack/residuals/dense_point_to_plane.hpp"
+#include "bundletrack/residuals/image_jacobian.hpp"
 #include "bundletrack/residuals/residual.hpp"
 
 namespace bundletrack {
@@ -85,12 +86,7 @@ struct DensePhotometric {
       const double iz = 1.0 / q.z();
       double brightness_t = 0.0, d_u = 0.0, d_v = 0.0;
       if (!image_t.sample(fx * q.x() * iz + cx, fy * q.y() * iz + cy, brightness_t, d_u, d_v)) continue;
-      // (dpi/dq)^T grad I: the image gradient pulled back to a camera-frame direction.
-      const Eigen::Vector3d g(d_u * fx * iz, d_v * fy * iz, -(d_u * fx * q.x() + d_v * fy * q.y()) * iz * iz);
-      const Eigen::Vector3d w = R_t.transpose() * g, a = T_s_inv * p_s;
-      Eigen::Matrix<double, 1, 6> J_t;
-      J_t.leftCols<3>() = w.transpose();
-      J_t.rightCols<3>() = a.cross(w).transpose();
+      const Eigen::Matrix<double, 1, 6> J_t = imageResidualJacobian(imageGradientAt(q, fx, fy, d_u, d_v), T_s_inv * p_s, R_t);
       // J_i is dr/dd_s = -J_t when s is the edge's first node, J_t when it is the second.
       system.addRelative(brightness_t - brightness_s, swapped ? J_t : Eigen::Matrix<double, 1, 6>(-J_t), loss, weight);
     }

@@ -1,0 +1,81 @@
+#pragma once
+
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+#include <opencv2/core.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "bundletrack/core/bilinear.hpp"
+#include "bundletrack/core/rgbd_frame.hpp"
+
+namespace bundletrack {
+
+/// A frame's silhouette of the object, as the silhouette term reads it: the signed distance to
+/// the mask's outline (pixels, positive outside, zero on the outline half a pixel beyond the
+/// outermost mask pixels) and its derivatives along u and v; the frame's depth there, which tells
+/// a point that the object hides from an occluder in front of it; and the frame's own object
+/// points, every `step` pixels of the mask that have depth (with or without a normal: the
+/// outermost ones are what the outline constrains), in the camera frame.
+struct SilhouetteImage {
+  cv::Mat samples;  ///< CV_32FC3, box.size(): signed distance and its derivatives along u and v
+  cv::Mat depth;  ///< CV_32FC1, box.size(): the frame's depth (metres, 0: none)
+  cv::Rect box;  ///< of the full image: the mask's bounding box grown by the margin
+  std::vector<cv::Vec3f> points;  ///< camera frame
+
+  bool empty() const { return samples.empty(); }
+
+  /// Bilinear signed distance and derivatives at full-resolution pixel (u, v); false outside the box.
+  bool sample(double u, double v, double& distance, double& du, double& dv) const {
+    return sampleBilinear(samples, box, {}, u, v, distance, du, dv);
+  }
+
+  /// Whether (u, v) lies deep inside the outline, a cheap test before sample(): its nearest pixel
+  /// is more than 2.5 px from every pixel off the mask (signed distance below -2), so the four
+  /// pixels a bilinear sample reads, within sqrt(2) of it, are all on the mask and the sampled
+  /// distance is negative.
+  bool deepInside(double u, double v) const {
+    const int x = int(std::lround(u)) - box.x, y = int(std::lround(v)) - box.y;
+    return x >= 0 && y >= 0 && x < box.width && y < box.height && samples.at<cv::Vec3f>(y, x)[0] < -2.0f;
+  }
+
+  /// The frame's depth at full-resolution pixel (u, v) (0: none, or outside the box).
+  float depthAt(int u, int v) const {
+    const int x = u - box.x, y = v - box.y;
+    return x >= 0 && y >= 0 && x < box.width && y < box.height ? depth.at<float>(y, x) : 0.0f;
+  }
+};
+
+/// The silhouette image of `frame` under `mask` over the mask's bounding box grown by `margin`
+/// pixels, its points every `step` pixels (empty without a mask pixel). Distances: exact Euclidean
+/// (cv::DIST_MASK_PRECISE) from the pixel centres; derivatives: the 3x3 Sobel operator over 8.
+inline SilhouetteImage makeSilhouetteImage(const RgbdFrame& frame, const cv::Mat& mask, int step, int margin) {
+  SilhouetteImage image;
+  if (mask.empty()) return image;
+  const cv::Rect object = cv::boundingRect(mask);
+  if (object.area() == 0) return image;
+  image.box = cv::Rect(object.x - margin, object.y - margin, object.width + 2 * margin, object.height + 2 * margin) &
+              cv::Rect({0, 0}, mask.size());
+  const cv::Mat inside = mask(image.box) != 0;
+  cv::Mat outside_distance, inside_distance;
+  cv::distanceTransform(~inside, outside_distance, cv::DIST_L2, cv::DIST_MASK_PRECISE);  // to the nearest mask pixel
+  cv::distanceTransform(inside, inside_distance, cv::DIST_L2, cv::DIST_MASK_PRECISE);  // to the nearest pixel off it
+  cv::Mat distance(inside.size(), CV_32FC1);
+  for (int y = 0; y < inside.rows; ++y)
+    for (int x = 0; x < inside.cols; ++x)
+      distance.at<float>(y, x) = inside.at<uchar>(y, x) ? 0.5f - inside_distance.at<float>(y, x)
+                                                        : outside_distance.at<float>(y, x) - 0.5f;
+  cv::Mat d_u, d_v;
+  cv::Sobel(distance, d_u, CV_32F, 1, 0, 3, 1.0 / 8.0, 0.0, cv::BORDER_REPLICATE);
+  cv::Sobel(distance, d_v, CV_32F, 0, 1, 3, 1.0 / 8.0, 0.0, cv::BORDER_REPLICATE);
+  cv::merge(std::vector<cv::Mat>{distance, d_u, d_v}, image.samples);
+  frame.depth(image.box).copyTo(image.depth);
+  const int first_u = (object.x + step - 1) / step * step, first_v = (object.y + step - 1) / step * step;
+  for (int v = first_v; v < object.y + object.height; v += step)
+    for (int u = first_u; u < object.x + object.width; u += step)
+      if (const cv::Vec3f& p = frame.points.at<cv::Vec3f>(v, u); mask.at<uchar>(v, u) && p[2] > 0.0f) image.points.push_back(p);
+  return image;
+}
+
+}  // namespace bundletrack
