@@ -34,8 +34,11 @@ namespace bundletrack {
 /// makes the outline, a line of samples, the same line integral at any grid step.
 struct DenseSilhouette {
   static constexpr bool kReadsSilhouettes = true;  ///< keyframes need their SilhouetteImage (Energy::readsSilhouettes)
-  /// Pixels: the spread of the mask's outline (given masks: a segmentation's boundary error).
-  double sigma = 1.0;
+  /// Pixels: the spread of the mask's outline. A rendered mask is exact to the pixel, but a real
+  /// one is not: colour and depth are registered to 1-3 px at edges, and a segmentation's boundary
+  /// errs by as much. With masks jittered by 1-2 px per frame, 1 px turned a 1 m mug by 13-42
+  /// degrees (2.6-5.0 without the term), 2 px by 8-9.
+  double sigma = 2.0;
   /// Pixels: the Huber delta its energy uses by default (a point farther out, where the mask
   /// misses part of the object, counts linearly).
   static constexpr double kHuberDelta = 1.0;
