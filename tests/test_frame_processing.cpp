@@ -1,6 +1,8 @@
 // Camera model, depth clean-up and normals against analytic geometry.
 #include <doctest/doctest.h>
 
+#include <cmath>
+#include <limits>
 #include <random>
 
 #include "bundletrack/core/intensity_image.hpp"
@@ -31,6 +33,22 @@ TEST_CASE("pinhole projection is K p / z and unprojection inverts it") {
   CHECK(uv.x() == doctest::Approx(Kp.x() / Kp.z()).epsilon(1e-6));
   CHECK(uv.y() == doctest::Approx(Kp.y() / Kp.z()).epsilon(1e-6));
   CHECK((kCamera.unproject(uv.x(), uv.y(), p.z()) - p).norm() < 1e-6f);
+}
+
+TEST_CASE("pixels are rounded half away from zero as std::lround does, and far or NaN coordinates fall outside") {
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> coordinate(-2000.0, 2000.0);
+  for (int k = 0; k < 100000; ++k) {
+    const double x = coordinate(rng);
+    REQUIRE(bt::roundToPixel(x) == std::lround(x));
+    REQUIRE(bt::roundToPixel(float(x)) == std::lround(float(x)));
+  }
+  for (const double tie : {-2.5, -1.5, -0.5, 0.5, 1.5, 2.5, 639.5})  // the cases rounding modes differ in
+    CHECK(bt::roundToPixel(tie) == std::lround(tie));
+  CHECK(bt::roundToPixel(std::nextafter(0.5, 0.0)) == 0);
+  CHECK(bt::roundToPixel(std::nextafter(-0.5, 0.0)) == 0);
+  for (const double far : {3e9, -3e9, std::numeric_limits<double>::infinity(), std::numeric_limits<double>::quiet_NaN()})
+    CHECK(bt::roundToPixel(far) < -1000000000);
 }
 
 TEST_CASE("unprojected depth of a plane lies on the plane and its normals are the plane's") {

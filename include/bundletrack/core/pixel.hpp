@@ -9,14 +9,17 @@
 
 namespace bundletrack {
 
-/// The pixel a continuous image coordinate falls in: rounded half away from zero.
+/// The pixel a continuous image coordinate falls in: rounded half away from zero, as std::lround,
+/// in inline arithmetic (the dense terms round millions of projections per frame, and the library
+/// call was 7 % of the tracker's time): truncation, then one step where the fraction is a half or
+/// more (x - trunc(x) is exact). Coordinates beyond 1e9 in magnitude, far outside any image, and
+/// NaN give -2e9, which every bounds check rejects.
 template <typename T>
 BUNDLETRACK_HOST_DEVICE int roundToPixel(T x) {
-#ifdef __CUDA_ARCH__
-  return int(::lround(x));
-#else
-  return int(std::lround(x));
-#endif
+  if (!(x > T(-1e9) && x < T(1e9))) return -2000000000;
+  const int truncated = int(x);
+  const T fraction = x - T(truncated);
+  return truncated + int(fraction >= T(0.5)) - int(fraction <= T(-0.5));
 }
 
 /// The pixel (u, v) that camera-frame point (x, y, z) projects into, u = fx x / z + cx and

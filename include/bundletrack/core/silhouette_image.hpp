@@ -8,6 +8,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "bundletrack/core/bilinear.hpp"
+#include "bundletrack/core/pixel.hpp"
 #include "bundletrack/core/rgbd_frame.hpp"
 
 namespace bundletrack {
@@ -36,7 +37,7 @@ struct SilhouetteImage {
   /// pixels a bilinear sample reads, within sqrt(2) of it, are all on the mask and the sampled
   /// distance is negative.
   bool deepInside(double u, double v) const {
-    const int x = int(std::lround(u)) - box.x, y = int(std::lround(v)) - box.y;
+    const int x = roundToPixel(u) - box.x, y = roundToPixel(v) - box.y;
     return x >= 0 && y >= 0 && x < box.width && y < box.height && samples.at<cv::Vec3f>(y, x)[0] < -2.0f;
   }
 

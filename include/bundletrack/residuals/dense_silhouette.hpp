@@ -5,6 +5,7 @@
 #include <Eigen/Geometry>
 
 #include "bundletrack/core/depth_noise.hpp"
+#include "bundletrack/core/pixel.hpp"
 #include "bundletrack/core/silhouette_image.hpp"
 #include "bundletrack/residuals/image_jacobian.hpp"
 #include "bundletrack/residuals/residual.hpp"
@@ -91,7 +92,7 @@ struct DenseSilhouette {
       if (t.deepInside(u, v) || !t.sample(u, v, distance, d_u, d_v) || distance <= 0.0) continue;
       // t must see past the point there: without a reading nothing says the object is not there
       // (a depth camera's narrower view, a shadow), with a nearer one an occluder hides it.
-      const float seen = t.depthAt(int(std::lround(u)), int(std::lround(v)));
+      const float seen = t.depthAt(roundToPixel(u), roundToPixel(v));
       if (seen <= 0.0f || seen < q.z() - occlusion_margin) continue;
       const Eigen::Vector3d g = imageGradientAt(q, fx, fy, d_u, d_v);
       // The point's depth error moves it along s's ray, and so across t's outline by g . R_t_s p_s / z_s
