@@ -36,14 +36,17 @@ struct PairSystem {
   void addRelative(double r, const Eigen::Matrix<double, 1, 6>& J_i, const Loss& loss, double weight) {
     const LossValue l = loss.evaluate(r * r);
     const double w = weight * l.d_rho;
-    relative_H_.noalias() += w * J_i.transpose() * J_i;
+    const Eigen::Matrix<double, 1, 6> wJ = w * J_i;
+    for (int c = 0; c < 6; ++c)  // the lower triangle; finish() mirrors it
+      for (int k = c; k < 6; ++k) relative_H_(k, c) += wJ(k) * J_i(c);
     relative_b_.noalias() += (w * r) * J_i.transpose();
     cost += weight * l.rho;
     ++residuals;
   }
 
-  /// Adds the sums of many addRelative() calls at once: sum w J_i^T J_i, sum w r J_i^T, the
-  /// weighted losses and their count (a GPU backend accumulates these on the device).
+  /// Adds the sums of many addRelative() calls at once: sum w J_i^T J_i (its lower triangle is
+  /// read), sum w r J_i^T, the weighted losses and their count (a GPU backend accumulates these on
+  /// the device).
   void addRelativeSums(const Eigen::Matrix<double, 6, 6>& JtWJ, const Eigen::Matrix<double, 6, 1>& JtWr, double cost_sum,
                        int count) {
     relative_H_ += JtWJ;
@@ -54,6 +57,8 @@ struct PairSystem {
 
   /// Folds the relative-pose accumulators into H and b; call once after the last addRelative().
   void finish() {
+    for (int c = 1; c < 6; ++c)
+      for (int k = 0; k < c; ++k) relative_H_(k, c) = relative_H_(c, k);
     H.topLeftCorner<6, 6>() += relative_H_;
     H.bottomRightCorner<6, 6>() += relative_H_;
     H.topRightCorner<6, 6>() -= relative_H_;
