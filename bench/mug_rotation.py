@@ -2,7 +2,7 @@
 """Mean rotation error of a tracked synthetic mug split by whether its handle is visible.
 
 Usage: mug_rotation.py SEQUENCE RUN  ->  prints
-  visible_frames,R_err_visible_deg,hidden_frames,R_err_hidden_deg
+  visible_frames,R_err_visible_deg,hidden_frames,R_err_hidden_deg,again_frames,R_err_again_deg
 
 A mug's body is a surface of revolution: while its handle is hidden nothing in the depth constrains
 the rotation about its axis (only texture can), so issue 15 scores the rotation where the handle
@@ -12,6 +12,9 @@ A handle point counts as visible in a frame when, projected with the true pose, 
 at its pixel lies within 3 sigma of the sensor's noise (structured light, Nguyen et al. 2012, the
 widest preset below 3 m) plus 5 mm of its depth; the handle is visible when a quarter of its
 points are (a side view shows about half of them; an edge peeking past the body, a tenth).
+The last two fields split off the visible frames after the handle was first hidden ("again"): the
+turn made while it was hidden is not in the data of a textureless mug, so those frames measure
+whether the tracker finds the handle again, the others whether it holds it.
 """
 import pathlib
 import sys
@@ -32,7 +35,7 @@ def rotation_error_deg(a, b):
     return np.degrees(np.arccos(np.clip(cosine, -1.0, 1.0)))
 
 
-visible, hidden = [], []
+visible, hidden, again = [], [], []
 for pose_file in sorted((run / "poses").glob("*.txt")):
     truth = np.loadtxt(seq / "annotated_poses" / pose_file.name)
     depth = cv2.imread(str(seq / "depth" / (pose_file.stem + ".png")), cv2.IMREAD_UNCHANGED).astype(float) / 1000.0
@@ -44,11 +47,17 @@ for pose_file in sorted((run / "poses").glob("*.txt")):
     reading = depth[v[inside], u[inside]]
     tolerance = 3.0 * (0.0012 + 0.0019 * (z - 0.4) ** 2) + 0.005
     seen = np.count_nonzero((reading > 0) & (np.abs(reading - z) < tolerance))
-    (visible if 4 * seen >= len(handle) else hidden).append(rotation_error_deg(truth, np.loadtxt(pose_file)))
+    error = rotation_error_deg(truth, np.loadtxt(pose_file))
+    if 4 * seen < len(handle):
+        hidden.append(error)
+        continue
+    visible.append(error)
+    if hidden:
+        again.append(error)
 
 
 def mean(values):
     return f"{np.mean(values):.2f}" if values else "n/a"
 
 
-print(f"{len(visible)},{mean(visible)},{len(hidden)},{mean(hidden)}")
+print(f"{len(visible)},{mean(visible)},{len(hidden)},{mean(hidden)},{len(again)},{mean(again)}")
