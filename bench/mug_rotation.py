@@ -12,9 +12,11 @@ A handle point counts as visible in a frame when, projected with the true pose, 
 at its pixel lies within 3 sigma of the sensor's noise (structured light, Nguyen et al. 2012, the
 widest preset below 3 m) plus 5 mm of its depth; the handle is visible when a quarter of its
 points are (a side view shows about half of them; an edge peeking past the body, a tenth).
-The last two fields split off the visible frames after the handle was first hidden ("again"): the
-turn made while it was hidden is not in the data of a textureless mug, so those frames measure
-whether the tracker finds the handle again, the others whether it holds it.
+The last two fields split off the visible frames after the handle was first hidden for 10 frames
+in a row or more ("again"; the motion turns the mug by up to 19 degrees in that time, and single
+frames drop below a quarter by noise): the turn made while it was hidden is not in the data of a
+textureless mug, so those frames measure whether the tracker finds the handle again, the others
+whether it holds it.
 """
 import pathlib
 import sys
@@ -36,6 +38,7 @@ def rotation_error_deg(a, b):
 
 
 visible, hidden, again = [], [], []
+hidden_run, was_hidden_long = 0, False
 for pose_file in sorted((run / "poses").glob("*.txt")):
     truth = np.loadtxt(seq / "annotated_poses" / pose_file.name)
     depth = cv2.imread(str(seq / "depth" / (pose_file.stem + ".png")), cv2.IMREAD_UNCHANGED).astype(float) / 1000.0
@@ -50,9 +53,12 @@ for pose_file in sorted((run / "poses").glob("*.txt")):
     error = rotation_error_deg(truth, np.loadtxt(pose_file))
     if 4 * seen < len(handle):
         hidden.append(error)
+        hidden_run += 1
+        was_hidden_long = was_hidden_long or hidden_run >= 10
         continue
+    hidden_run = 0
     visible.append(error)
-    if hidden:
+    if was_hidden_long:
         again.append(error)
 
 
