@@ -342,9 +342,17 @@ class Tracker {
     return makeKeyframe(id, frame, mask, std::move(features), T_cam_obj, camera_, grid_step_, with_image, with_silhouette);
   }
 
-  /// The current frame as a graph node at its coarse pose, with its features.
+  /// The current frame as a graph node at its coarse pose, with its features. Its grid and images
+  /// depend on the mask alone: under the mask of the node before (a given mask, tried again from
+  /// another coarse pose or with keypoints after the surface alone) they are kept.
   const Keyframe& makeNode(FrameContext& ctx) {
     clock_.enter(&StageTimings::graph);
+    if (!ctx.current_mask.empty() && ctx.current_mask.data == ctx.masked.mask.data) {
+      ctx.current.features = std::move(ctx.features);
+      ctx.current.T_cam_obj = ctx.coarse.T_cam_obj;
+      return ctx.current;
+    }
+    ctx.current_mask = ctx.masked.mask;
     return ctx.current = keyframeOf(ctx.id, ctx.masked, ctx.masked.mask, std::move(ctx.features), ctx.coarse.T_cam_obj);
   }
 
@@ -400,6 +408,7 @@ class Tracker {
     if (refined.data == ctx.masked.mask.data || cv::countNonZero(refined) == 0) return;
     ctx.masked.mask = ctx.result.mask = refined;
     keepFeaturesInside(ctx.current.features, refined);
+    ctx.current_mask = refined;
     ctx.current = keyframeOf(ctx.id, ctx.masked, refined, std::move(ctx.current.features), ctx.result.T_cam_obj);
   }
 

@@ -3,6 +3,8 @@
 #include <optional>
 #include <vector>
 
+#include <opencv2/core.hpp>
+
 #include "bundletrack/graph/pose_graph.hpp"
 #include "bundletrack/solvers/gauss_newton.hpp"
 #include "bundletrack/tracking/track_result.hpp"
@@ -33,6 +35,7 @@ struct FrameContext {
   std::vector<CoarseEstimate> candidates;  ///< coarse poses to try, in order (several only after lost frames)
   CoarseEstimate coarse;  ///< the one being tried
   Keyframe current;  ///< the frame as a graph node
+  cv::Mat current_mask;  ///< the mask `current`'s grid and images were made under (its buffer kept: no other mask shares it)
   PoseGraph graph;
   OptimizationReport optimisation;
   TrackResult result;
