@@ -210,7 +210,7 @@ class ObjectOutput {
       box_ = bt::ObjectBox::bounding(model_);
     }
     csv_.open(out_ / "track.csv");
-    csv_ << "frame,status,by_surface,keypoints,matches,inliers,read_ms,mask_ms,features_ms,matching_ms,ransac_ms,graph_ms,solve_ms,"
+    csv_ << "frame,status,by_surface,keypoints,followed,matches,inliers,read_ms,mask_ms,features_ms,matching_ms,ransac_ms,graph_ms,solve_ms,"
             "total_ms"
          << (scored_ ? ",rotation_error_deg,translation_error_cm" : "") << (propagated_ ? ",mask_iou" : "") << ",problem\n";
   }
@@ -228,7 +228,7 @@ class ObjectOutput {
     const std::string name = sequence_.frameNames()[i];
     const bool readable = problem.empty();
     if (!result && !started) {
-      csv_ << name << ",not_started" << std::string(12 + (scored_ ? 2 : 0) + (propagated_ ? 1 : 0), ',') << ','
+      csv_ << name << ",not_started" << std::string(13 + (scored_ ? 2 : 0) + (propagated_ ? 1 : 0), ',') << ','
            << csvField(problem) << '\n';
       return result;
     }
@@ -243,10 +243,11 @@ class ObjectOutput {
     last_pose_ = result->T_cam_obj;
     lost_ += result->status == bt::TrackStatus::Lost;
     by_surface_ += result->surface_only;
+    by_flow_ += result->followed > 0;
     ++frames_;
     bt::io::writePose(out_ / "poses" / (name + ".txt"), result->T_cam_obj);
     const auto& t = result->timings;
-    csv_ << name << ',' << bt::statusName(result->status) << ',' << result->surface_only << ',' << result->keypoints << ','
+    csv_ << name << ',' << bt::statusName(result->status) << ',' << result->surface_only << ',' << result->keypoints << ',' << result->followed << ','
          << result->matches << ',' << result->inliers << ',' << read_ms << ',' << t.mask << ',' << t.features << ','
          << t.matching << ',' << t.ransac << ',' << t.graph << ',' << t.solve << ',' << t.total;
     if (scored_) {
@@ -303,6 +304,9 @@ class ObjectOutput {
     if (by_surface_ > 0)
       std::printf("%s%d frames tracked by the dense term alone, without keypoints (features.detect: on_demand)\n", p,
                   by_surface_);
+    if (by_flow_ > 0)
+      std::printf("%s%d frames tracked with the last frame's keypoints followed by optical flow (features.follow)\n", p,
+                  by_flow_);
     if (!mask_ious_.empty()) {
       double sum = 0.0;
       for (const double iou : mask_ious_) sum += iou;
@@ -352,7 +356,7 @@ class ObjectOutput {
   std::optional<bt::ObjectBox> box_;
   std::ofstream csv_;
   std::optional<std::size_t> first_frame_;  ///< the frame the object started in
-  int frames_ = 0, lost_ = 0, unreadable_ = 0, unscored_ = 0, by_surface_ = 0;
+  int frames_ = 0, lost_ = 0, unreadable_ = 0, unscored_ = 0, by_surface_ = 0, by_flow_ = 0;
   std::string first_unreadable_;
   bt::SE3d last_pose_;  ///< what a frame the object sits out reports
   std::vector<bt::SE3d> truth_;

@@ -1,9 +1,12 @@
 #pragma once
 
 #include <algorithm>
+#include <cmath>
 #include <optional>
 #include <utility>
 #include <vector>
+
+#include <opencv2/imgproc.hpp>
 
 #include "bundletrack/core/angles.hpp"
 #include "bundletrack/core/error.hpp"
@@ -75,7 +78,7 @@ class Tracker {
     lost_streak_ = 0;
     pool_.add(keyframeOf(0, masked, masked.mask, features, T_cam_obj));
     result.keypoints = int(features.size());
-    last_ = LastGood{0, T_cam_obj, pool_[0].surface, {0, T_cam_obj, std::move(features)}};
+    last_ = LastGood{0, T_cam_obj, pool_[0].surface, keypointFrame(0, T_cam_obj, std::move(features), frame, masked.mask, 0)};
     result.T_cam_obj = T_cam_obj;
     result.status = TrackStatus::Tracked;
     result.timings = clock_.stop();
@@ -89,7 +92,7 @@ class Tracker {
     if (!last_) throw InputError("frame " + frame.name, "track() called before initialize()");
     FrameContext ctx = beginFrame(frame);
     if (!searchObject(ctx)) return lost(ctx);  // the object is out of sight
-    if (!trackBySurface(ctx)) {
+    if (!trackBySurface(ctx) && !trackByFollowing(ctx)) {
       detectKeypoints(ctx);
       if (!estimateCoarsePose(ctx)) return lost(ctx);
       if (!refineCoarsePose(ctx)) return lost(ctx);
@@ -101,12 +104,32 @@ class Tracker {
   }
 
  private:
-  /// A frame's keypoints with the frame's id and pose.
+  /// A frame's keypoints with the frame's id and pose, and what following them needs: the frame's
+  /// grey image (empty when the correspondence source cannot follow) and object mask, and, for
+  /// followed keypoints, how many the chain of followed frames began with (0: detected here).
   struct KeypointFrame {
     int id;
     SE3d T_cam_obj;
     FrameFeatures features;
+    cv::Mat gray;
+    cv::Mat mask;
+    int chain_start = 0;
   };
+
+  /// A frame's keypoints as the next frame may follow them: with the frame's grey image and a copy
+  /// of its mask (the caller may reuse its buffers for the next frame) where the source can follow
+  /// and following is on.
+  KeypointFrame keypointFrame(int id, const SE3d& T_cam_obj, FrameFeatures features, const RgbdFrame& frame,
+                              const cv::Mat& mask, int chain_start) const {
+    KeypointFrame keypoints{id, T_cam_obj, std::move(features), {}, {}, chain_start};
+    if constexpr (FollowingSource<Correspondences>) {
+      if (settings_.keypoints == KeypointSchedule::OnDemand && settings_.follow_keypoints) {
+        cv::cvtColor(frame.color, keypoints.gray, cv::COLOR_BGR2GRAY);
+        keypoints.mask = mask.clone();
+      }
+    }
+    return keypoints;
+  }
 
   /// What the next frame is tracked from: the last frame that was not lost, and the last good
   /// frame whose keypoints were detected (the same frame unless keypoints are detected on demand).
@@ -156,6 +179,45 @@ class Tracker {
     }
     ctx.masked.mask = search_region;
     ctx.result.mask = cv::Mat();
+    return false;
+  }
+
+  /// Keypoints on demand, where the surface alone cannot hold the frame: the keypoints of the last
+  /// good frame, when it has its own (detected or followed), are followed into this frame by
+  /// optical flow (FollowingSource), RANSAC on those pairs gives the coarse pose (paper IV-B), and
+  /// the graph runs as with detected keypoints. Kept when RANSAC keeps follow_min_share of the
+  /// keypoints the chain of followed frames began with (and min_inliers) and the verifier accepts the
+  /// graph's pose; otherwise the frame starts over, detecting keypoints, from its search region.
+  bool trackByFollowing(FrameContext& ctx) {
+    const KeypointFrame& last = last_->keypoints;
+    if (!settings_.follow_keypoints || settings_.keypoints != KeypointSchedule::OnDemand || ctx.recovering ||
+        last.id != last_->id || last.gray.empty())
+      return false;
+    clock_.enter(&StageTimings::features);
+    FollowedFeatures followed;
+    if constexpr (FollowingSource<Correspondences>) followed = correspondences_.follow(last.gray, last.mask, last.features, ctx.masked);
+    const auto estimate = clock_.measure(&StageTimings::ransac, [&] {
+      return registration_.estimate(last.features, followed.features, followed.matches);
+    });
+    const int chain_start = last.chain_start > 0 ? last.chain_start : followed.tried;
+    const int needed = std::max(settings_.min_inliers, int(std::ceil(settings_.follow_min_share * chain_start)));
+    if (int(estimate.inliers.size()) < needed) return false;
+    CoarseEstimate coarse{estimate.T_second_first * last.T_cam_obj, true, true, Evidence::Features, {}};
+    for (const int k : estimate.inliers) coarse.last_inliers.push_back(followed.matches[std::size_t(k)]);
+    const cv::Mat search_region = ctx.masked.mask;
+    ctx.features = std::move(followed.features);
+    if (optimiseFrom(ctx, coarse, nullptr) && acceptPose(ctx) && ctx.result.status == TrackStatus::Tracked) {
+      ctx.keypoints_followed = true;
+      ctx.chain_start = chain_start;
+      ctx.result.followed = int(ctx.current.features.size());
+      ctx.result.matches = int(followed.matches.size());
+      ctx.result.inliers = int(estimate.inliers.size());
+      return true;
+    }
+    ctx.masked.mask = search_region;
+    ctx.result.mask = cv::Mat();
+    ctx.result.status = TrackStatus::Lost;
+    ctx.features = FrameFeatures();
     return false;
   }
 
@@ -427,8 +489,9 @@ class Tracker {
       }
       if (const int evicted = pool_.add(ctx.current); evicted >= 0) cache_.forget(evicted);
     }
-    KeypointFrame keypoints = ctx.keypoints_detected
-                                  ? KeypointFrame{ctx.id, ctx.result.T_cam_obj, std::move(ctx.current.features)}
+    KeypointFrame keypoints = ctx.keypoints_detected || ctx.keypoints_followed
+                                  ? keypointFrame(ctx.id, ctx.result.T_cam_obj, std::move(ctx.current.features), ctx.frame,
+                                                  ctx.masked.mask, ctx.keypoints_detected ? 0 : ctx.chain_start)
                                   : std::move(last_->keypoints);
     last_ = LastGood{ctx.id, ctx.result.T_cam_obj, ctx.current.surface, std::move(keypoints)};
     lost_streak_ = 0;

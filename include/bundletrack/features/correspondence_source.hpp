@@ -20,4 +20,14 @@ concept CorrespondenceSource = requires(T& source, const T& const_source, const 
   { const_source.match(features, features, gate) } -> std::same_as<std::vector<FeatureMatch>>;
 };
 
+/// A correspondence source that can also follow the last frame's keypoints (on its grey image and
+/// object mask) into the next frame, cheaper than detecting and matching them (Tracker: keypoints
+/// on demand).
+template <typename T>
+concept FollowingSource = CorrespondenceSource<T> && requires(const T& source, const cv::Mat& last_gray,
+                                                               const cv::Mat& last_mask, const FrameFeatures& last,
+                                                               const RgbdFrame& frame) {
+  { source.follow(last_gray, last_mask, last, frame) } -> std::same_as<FollowedFeatures>;
+};
+
 }  // namespace bundletrack

@@ -51,4 +51,12 @@ struct FeatureMatch {
   bool operator==(const FeatureMatch&) const = default;
 };
 
+/// The keypoints of one frame found again in the next (by optical flow): the next frame's features,
+/// each keeping the descriptor of the keypoint it follows, and which keypoint of the first each is.
+struct FollowedFeatures {
+  FrameFeatures features;
+  std::vector<FeatureMatch> matches;  ///< first: index in the followed frame's features, second: in `features`
+  int tried = 0;  ///< keypoints of the first frame that could be followed (their window on the object)
+};
+
 }  // namespace bundletrack

@@ -41,10 +41,11 @@ inline Eigen::Vector3f fitNormal(const cv::Mat& points, int u, int v, int r, flo
 
 /// Lifts full-resolution keypoints to 3-D with the frame's depth; keypoints without a valid depth
 /// reading or normal are dropped together with their descriptor row. max_depth_jump is widened by
-/// the frame's noise at each keypoint's depth.
+/// the frame's noise at each keypoint's depth. `lifted`, when given, receives the index in `pixels`
+/// of every feature kept.
 inline FrameFeatures liftKeypoints(const RgbdFrame& frame, const std::vector<cv::Point2f>& pixels,
                                    const cv::Mat& descriptors, int norm_type, int normal_radius = 3,
-                                   float max_depth_jump = 0.02f) {
+                                   float max_depth_jump = 0.02f, std::vector<int>* lifted = nullptr) {
   FrameFeatures features;
   features.norm_type = norm_type;
   std::vector<int> kept;
@@ -65,6 +66,7 @@ inline FrameFeatures liftKeypoints(const RgbdFrame& frame, const std::vector<cv:
   std::vector<float> depths;
   for (const Eigen::Vector3f& p : features.points) depths.push_back(p.z());
   features.noise_scale = frame.noise.atMedian(std::move(depths));
+  if (lifted) *lifted = std::move(kept);
   return features;
 }
 

@@ -11,6 +11,7 @@
 #include "bundletrack/features/lift_keypoints.hpp"
 #include "bundletrack/features/matching.hpp"
 #include "bundletrack/features/object_crop.hpp"
+#include "bundletrack/features/optical_flow.hpp"
 
 namespace bundletrack {
 
@@ -62,11 +63,18 @@ class OpenCvFeatureSource {
     return matchFeatures(first, second, matching_, gate);
   }
 
+  /// The keypoints of the frame before (`last`, on its grey image and object mask) found in
+  /// `frame` by optical flow, lifted as detected ones are (followFeatures).
+  FollowedFeatures follow(const cv::Mat& last_gray, const cv::Mat& last_mask, const FrameFeatures& last,
+                          const RgbdFrame& frame) const {
+    return followFeatures(last_gray, last_mask, last, frame, flow_, crop_.normal_radius, crop_.normal_max_depth_jump);
+  }
+
  protected:
   OpenCvFeatureSource(cv::Ptr<cv::Feature2D> detector, int norm_type, int max_keypoints, CropSettings crop,
-                      MatchSettings matching)
+                      MatchSettings matching, FlowSettings flow)
       : detector_(std::move(detector)), norm_type_(norm_type), max_keypoints_(max_keypoints), crop_(crop),
-        matching_(matching) {}
+        matching_(matching), flow_(flow) {}
 
  private:
   cv::Ptr<cv::Feature2D> detector_;
@@ -74,6 +82,7 @@ class OpenCvFeatureSource {
   int max_keypoints_;
   CropSettings crop_;
   MatchSettings matching_;
+  FlowSettings flow_;
 };
 
 struct SiftSettings {
@@ -84,6 +93,7 @@ struct SiftSettings {
   int octave_layers = 3;
   CropSettings crop;
   MatchSettings matching;
+  FlowSettings flow;
 };
 
 /// SIFT, the default source: 500 keypoints, contrast threshold 0.01 as in the original
@@ -95,7 +105,7 @@ class SiftFeatures : public OpenCvFeatureSource {
   explicit SiftFeatures(const Settings& s)
       : OpenCvFeatureSource(cv::SIFT::create(s.max_keypoints, s.octave_layers, s.contrast_threshold, s.edge_threshold,
                                              s.sigma),
-                            cv::NORM_L2, s.max_keypoints, s.crop, s.matching) {}
+                            cv::NORM_L2, s.max_keypoints, s.crop, s.matching, s.flow) {}
 };
 
 struct OrbSettings {
@@ -105,6 +115,7 @@ struct OrbSettings {
   int fast_threshold = 10;  ///< lower than OpenCV's 20: object crops are small and often low-contrast
   CropSettings crop;
   MatchSettings matching;
+  FlowSettings flow;
 };
 
 /// ORB: binary descriptors, cheaper than SIFT, weaker under scale change.
@@ -115,7 +126,7 @@ class OrbFeatures : public OpenCvFeatureSource {
   explicit OrbFeatures(const Settings& s)
       : OpenCvFeatureSource(cv::ORB::create(s.max_keypoints, s.scale_factor, s.levels, 31, 0, 2, cv::ORB::HARRIS_SCORE,
                                             31, s.fast_threshold),
-                            cv::NORM_HAMMING, s.max_keypoints, s.crop, s.matching) {}
+                            cv::NORM_HAMMING, s.max_keypoints, s.crop, s.matching, s.flow) {}
 };
 
 struct AkazeSettings {
@@ -123,6 +134,7 @@ struct AkazeSettings {
   float threshold = 0.0005f;  ///< detector response threshold (OpenCV default 0.001)
   CropSettings crop;
   MatchSettings matching;
+  FlowSettings flow;
 };
 
 /// AKAZE: nonlinear scale space with binary (MLDB) descriptors.
@@ -132,7 +144,7 @@ class AkazeFeatures : public OpenCvFeatureSource {
   AkazeFeatures() : AkazeFeatures(Settings{}) {}
   explicit AkazeFeatures(const Settings& s)
       : OpenCvFeatureSource(cv::AKAZE::create(cv::AKAZE::DESCRIPTOR_MLDB, 0, 3, s.threshold), cv::NORM_HAMMING,
-                            s.max_keypoints, s.crop, s.matching) {}
+                            s.max_keypoints, s.crop, s.matching, s.flow) {}
 };
 
 }  // namespace bundletrack

@@ -32,6 +32,8 @@ struct FrameContext {
   RgbdFrame masked;  ///< the frame with the mask the stages work on (shares the image buffers)
   FrameFeatures features;  ///< detected; moves into `current` when the graph is built
   bool keypoints_detected = false;  ///< on this frame (not always with keypoints on demand)
+  bool keypoints_followed = false;  ///< the last good frame's keypoints, followed into this frame (optical flow)
+  int chain_start = 0;  ///< then: how many keypoints the chain of followed frames began with
   std::vector<CoarseEstimate> candidates;  ///< coarse poses to try, in order (several only after lost frames)
   CoarseEstimate coarse;  ///< the one being tried
   Keyframe current;  ///< the frame as a graph node

@@ -46,6 +46,7 @@ struct TrackResult {
   cv::Mat mask;  ///< the object mask the frame was tracked with; empty when none was made
   StageTimings timings;
   bool surface_only = false;  ///< tracked by the dense term alone (keypoints on demand)
+  int followed = 0;  ///< keypoints followed into this frame from the one before by optical flow (when it used them)
 };
 
 }  // namespace bundletrack

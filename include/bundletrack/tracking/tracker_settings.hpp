@@ -11,9 +11,10 @@ namespace bundletrack {
 enum class KeypointSchedule {
   EveryFrame,  ///< paper IV: every frame
   /// Only where the dense term alone cannot be trusted (Tracker::trackBySurface): a frame is first
-  /// tracked without keypoints, from the last good pose; keypoints are detected when the surface
-  /// seen is geometrically unstable, when the verifier refuses that pose, after lost frames and on
-  /// frames that become keyframes.
+  /// tracked without keypoints, from the last good pose; where the surface seen is geometrically
+  /// unstable or the verifier refuses that pose, the last frame's keypoints are followed into it
+  /// (Tracker::trackByFollowing, TrackerSettings::follow_keypoints); keypoints are detected when
+  /// that fails too, after lost frames and on frames that become keyframes.
   OnDemand,
 };
 
@@ -68,6 +69,15 @@ struct TrackerSettings {
   /// EveryFrame on every cell, and it skips keypoints on most frames of the shared container and
   /// mug (bench/RESULTS.md); EveryFrame is the paper's schedule.
   KeypointSchedule keypoints = KeypointSchedule::OnDemand;
+  /// OnDemand: where the surface alone cannot hold a frame, the last good frame's keypoints, when
+  /// it has its own, are first followed into it by optical flow (FollowingSource; Tracker::
+  /// trackByFollowing) and detected only when that fails.
+  bool follow_keypoints = true;
+  /// A frame's followed keypoints are kept when RANSAC keeps at least this share of the keypoints
+  /// the chain of followed frames began with (those of the detecting frame that could be followed;
+  /// and min_inliers): the chain thins as keypoints leave the view or fail the flow's checks, and
+  /// a frame that detects again also finds those of the surface that came into view.
+  double follow_min_share = 0.5;
   /// OnDemand: the dense term alone may track a frame whose surface has at least this geometric
   /// stability (geometricStability: lambda_min / lambda_max of its point-to-plane information).
   /// 0.02: the weakest direction at most 7x less certain than the strongest (1 / sqrt(0.02)); a

@@ -36,6 +36,14 @@ class GpuMatched {
 
   FrameFeatures detect(const RgbdFrame& frame) { return detector_.detect(frame); }
 
+  /// The Detector's following by optical flow, where it has one (FollowingSource).
+  FollowedFeatures follow(const cv::Mat& last_gray, const cv::Mat& last_mask, const FrameFeatures& last,
+                          const RgbdFrame& frame) const
+    requires FollowingSource<Detector>
+  {
+    return detector_.follow(last_gray, last_mask, last, frame);
+  }
+
   std::vector<FeatureMatch> match(const FrameFeatures& first, const FrameFeatures& second,
                                   const std::optional<MatchGate>& gate = std::nullopt) const {
     if (first.size() < 2 || second.size() < 2) return {};  // no second neighbour for the ratio test
