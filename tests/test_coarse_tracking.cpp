@@ -129,9 +129,10 @@ TEST_CASE("optical flow follows keypoints into the next frame to where the true 
   bt::SiftFeatures sift;
   const bt::FrameFeatures detected = sift.detect(before);
   REQUIRE(detected.size() > 100);
-  cv::Mat gray;
+  cv::Mat gray, gray_after;
   cv::cvtColor(before.color, gray, cv::COLOR_BGR2GRAY);
-  const bt::FollowedFeatures followed = sift.follow(gray, before.mask, detected, after);
+  cv::cvtColor(after.color, gray_after, cv::COLOR_BGR2GRAY);
+  const bt::FollowedFeatures followed = sift.follow(gray, before.mask, detected, after, gray_after);
   REQUIRE(followed.matches.size() == followed.features.size());
   // Where each keypoint truly goes: its pixel lifted with the renderer's exact depth, moved by the
   // exact relative pose, projected (the depth of the nearest pixel centre: < 1 mm off on these
@@ -168,5 +169,5 @@ TEST_CASE("optical flow follows keypoints into the next frame to where the true 
   // Followed keypoints must land on the frame's mask: into a frame without the object, none do.
   bt::RgbdFrame elsewhere = after;
   elsewhere.mask = cv::Mat::zeros(after.mask.size(), CV_8UC1);
-  CHECK(sift.follow(gray, before.mask, detected, elsewhere).features.size() == 0);
+  CHECK(sift.follow(gray, before.mask, detected, elsewhere, gray_after).features.size() == 0);
 }

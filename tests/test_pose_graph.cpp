@@ -289,6 +289,105 @@ TEST_CASE("a batch residual gets every edge of the graph in one call and adds wh
   CHECK(one_thread.cost == by_edge.cost);
 }
 
+TEST_CASE("a kept edge system moved along its linear model equals the system of the linear residual at the new poses") {
+  // Residuals exactly linear in the right perturbations, r(d) = r0 + J d, made into a system at
+  // d = 0 and, independently, at d: the kept one moved by d must be the latter up to rounding.
+  std::mt19937 rng(3);
+  std::normal_distribution<double> normal(0.0, 1.0);
+  std::vector<Eigen::Vector3d> r0(20);
+  std::vector<Eigen::Matrix<double, 3, 12>> J(20);
+  for (std::size_t k = 0; k < r0.size(); ++k) {
+    r0[k] = Eigen::Vector3d::NullaryExpr([&] { return 0.01 * normal(rng); });
+    J[k] = Eigen::Matrix<double, 3, 12>::NullaryExpr([&] { return normal(rng); });
+  }
+  const auto systemAt = [&](const Eigen::Matrix<double, 12, 1>& d) {
+    bt::PairSystem system;
+    for (std::size_t k = 0; k < r0.size(); ++k)
+      system.add<3>(r0[k] + J[k] * d, J[k].leftCols<6>(), J[k].rightCols<6>(), bt::TrivialLoss{}, 1.0);
+    return system;
+  };
+  const bt::SE3d T_a = perturbed(bt::SE3d{}, rng, 0.3), T_b = perturbed(bt::SE3d{}, rng, 0.3);
+  bt::EdgeLinearisationCache cache({.max_translation = 1e-3, .max_rotation = 2e-3});
+  REQUIRE(cache.enabled());
+  cache.keep(4, 9, T_a, T_b, systemAt(Eigen::Matrix<double, 12, 1>::Zero()));
+  Eigen::Matrix<double, 12, 1> d;
+  d << 3e-4, -2e-4, 1e-4, 5e-4, -8e-4, 2e-4, -1e-4, 4e-4, 2e-4, -3e-4, 1e-4, 6e-4;
+  bt::PairSystem moved;
+  REQUIRE(cache.reuse(4, 9, T_a * bt::SE3d::exp(d.head<6>()), T_b * bt::SE3d::exp(d.tail<6>()), moved));
+  const bt::PairSystem fresh = systemAt(d);
+  CHECK(moved.H == fresh.H);
+  CHECK((moved.b - fresh.b).norm() < 1e-12 * fresh.b.norm());
+  CHECK(moved.cost == doctest::Approx(fresh.cost).epsilon(1e-12));
+  CHECK(moved.residuals == fresh.residuals);
+  // Farther than the settings allow, in either pose, or another pair, or a forgotten keyframe: none.
+  bt::SE3d::Tangent far = bt::SE3d::Tangent::Zero();
+  far[0] = 1.1e-3;
+  CHECK_FALSE(cache.reuse(4, 9, T_a * bt::SE3d::exp(far), T_b, moved));
+  far << 0, 0, 0, 0, 0, 2.1e-3;
+  CHECK_FALSE(cache.reuse(4, 9, T_a, T_b * bt::SE3d::exp(far), moved));
+  CHECK_FALSE(cache.reuse(9, 4, T_b, T_a, moved));
+  CHECK(cache.reuse(4, 9, T_a, T_b, moved));
+  cache.forget(9);
+  CHECK_FALSE(cache.reuse(4, 9, T_a, T_b, moved));
+  CHECK_FALSE(bt::EdgeLinearisationCache().enabled());
+}
+
+TEST_CASE("lazy relinearisation: edges between pool keyframes are linearised again only when a keyframe has moved") {
+  std::mt19937 rng(5);
+  const bt::PinholeCameraf grid{150.0f, 150.0f, 39.5f, 29.5f};
+  const std::vector<bt::SE3d> truth = fourViews();
+  std::vector<bt::Keyframe> frames;
+  for (int k = 0; k < 4; ++k) frames.push_back(surfaceKeyframe(k, truth[std::size_t(k)], grid));
+  const std::vector<bt::FeatureMatch> none;
+  std::vector<bt::SE3d> start = truth;
+  for (int k = 1; k < 4; ++k) start[k] = perturbed(truth[k], rng, k < 3 ? 2e-4 : 0.004);  // keyframes settled, the frame not
+  bt::PoseGraph graph = allPairsGraph(frames, start, none);
+  graph.pool_indices = {0, 1, 2};  // nodes 0-2 are the pool's keyframes, node 3 the current frame
+  const bt::Energy<bt::Term<BatchedDense, bt::HuberLoss>> energy;
+  std::vector<std::size_t>& batches = *std::get<0>(energy.terms).residual.batches;
+  bt::GaussNewtonSettings settings;
+  settings.iterations = 10;
+  settings.min_translation_step = settings.min_rotation_step = 0.0;  // every step, so that both runs take as many
+  std::vector<bt::SE3d> every_step = start;
+  bt::optimizePoseGraph(energy.over(graph), bt::DenseLDLT{}, every_step, settings);
+  REQUIRE(batches.size() == 10);
+  for (const std::size_t edges : batches) CHECK(edges == 6);
+  batches.clear();
+  // The tracker's settings: a keyframe relinearises its edges after moving 0.5 mm or turning 1 mrad.
+  bt::EdgeLinearisationCache kept({.max_translation = 5e-4, .max_rotation = 1e-3});
+  std::vector<bt::SE3d> lazy = start;
+  bt::optimizePoseGraph(energy.over(graph, &kept), bt::DenseLDLT{}, lazy, settings);
+  REQUIRE(batches.size() == 10);
+  CHECK(batches[0] == 6);
+  std::size_t linearised = 0;
+  for (const std::size_t edges : batches) linearised += edges;
+  MESSAGE("edges linearised in 10 steps: " << linearised << " lazily, 60 every step");
+  CHECK(linearised < 60 * 3 / 4);
+  // The kept systems pair points as the poses they were made at did (the keyframes start 0.35 mm
+  // from the truth): on this coarse grid (4 mm cells) that moves the minimum by less than the
+  // sampling error every-step relinearisation itself leaves (up to 65 um and 0.5 mrad here).
+  // Kept systems left where they were made (no b + H d) hold the keyframes at their start instead.
+  for (int k = 1; k < 4; ++k) {
+    CAPTURE(k);
+    const double moved = (lazy[k].translation() - every_step[k].translation()).norm();
+    const double turned = bt::rotationGeodesic(lazy[k].rotation(), every_step[k].rotation());
+    MESSAGE("node " << k << ": lazy vs every step " << moved * 1e6 << " um, " << turned * 1e3 << " mrad; every step vs truth "
+                     << (every_step[k].translation() - truth[k].translation()).norm() * 1e6 << " um, "
+                     << bt::rotationGeodesic(every_step[k].rotation(), truth[k].rotation()) * 1e3 << " mrad; lazy vs truth "
+                     << (lazy[k].translation() - truth[k].translation()).norm() * 1e6 << " um, "
+                     << bt::rotationGeodesic(lazy[k].rotation(), truth[k].rotation()) * 1e3 << " mrad");
+    CHECK(moved < 5e-5);
+    CHECK(turned < 5e-4);
+    CHECK((lazy[k].translation() - truth[k].translation()).norm() < 1e-4);
+    CHECK(bt::rotationGeodesic(lazy[k].rotation(), truth[k].rotation()) < 1e-3);
+  }
+  // A second optimisation from the result reuses every keyframe edge: no keyframe moves far.
+  batches.clear();
+  std::vector<bt::SE3d> again = lazy;
+  bt::optimizePoseGraph(energy.over(graph, &kept), bt::DenseLDLT{}, again, settings);
+  for (const std::size_t edges : batches) CHECK(edges == 3);
+}
+
 TEST_CASE("keyframe pool: greedy selection keeps frame 0 and follows the geodesic sums, and the pool is bounded") {
   bt::KeyframePool pool(4);
   const Eigen::Vector3d rotations[4] = {{0, 0, 0}, {0.5, 0, 0}, {0, 0, 0.5}, {0, 0, 0.2}};

@@ -74,11 +74,14 @@ class Tracker {
     clock_.enter(&StageTimings::graph);
     pool_ = KeyframePool(settings_.pool_capacity);
     cache_.clear();
+    linearisations_ = EdgeLinearisationCache(settings_.relinearisation);
     frame_index_ = 0;
     lost_streak_ = 0;
     pool_.add(keyframeOf(0, masked, masked.mask, features, T_cam_obj));
     result.keypoints = int(features.size());
-    last_ = LastGood{0, T_cam_obj, pool_[0].surface, keypointFrame(0, T_cam_obj, std::move(features), frame, masked.mask, 0)};
+    cv::Mat gray;
+    if (followsKeypoints()) cv::cvtColor(frame.color, gray, cv::COLOR_BGR2GRAY);
+    last_ = LastGood{0, T_cam_obj, pool_[0].surface, keypointFrame(0, T_cam_obj, std::move(features), gray, masked.mask, 0)};
     result.T_cam_obj = T_cam_obj;
     result.status = TrackStatus::Tracked;
     result.timings = clock_.stop();
@@ -116,19 +119,28 @@ class Tracker {
     int chain_start = 0;
   };
 
-  /// A frame's keypoints as the next frame may follow them: with the frame's grey image and a copy
-  /// of its mask (the caller may reuse its buffers for the next frame) where the source can follow
-  /// and following is on.
-  KeypointFrame keypointFrame(int id, const SE3d& T_cam_obj, FrameFeatures features, const RgbdFrame& frame,
+  /// Whether the next frame may follow this one's keypoints: the source can follow and following is on.
+  bool followsKeypoints() const {
+    return FollowingSource<Correspondences> && settings_.keypoints == KeypointSchedule::OnDemand && settings_.follow_keypoints;
+  }
+
+  /// A frame's keypoints as the next frame may follow them: with the frame's grey image (`gray`,
+  /// made by grayOf) and a copy of its mask (the caller may reuse its buffers for the next frame)
+  /// where followsKeypoints().
+  KeypointFrame keypointFrame(int id, const SE3d& T_cam_obj, FrameFeatures features, const cv::Mat& gray,
                               const cv::Mat& mask, int chain_start) const {
     KeypointFrame keypoints{id, T_cam_obj, std::move(features), {}, {}, chain_start};
-    if constexpr (FollowingSource<Correspondences>) {
-      if (settings_.keypoints == KeypointSchedule::OnDemand && settings_.follow_keypoints) {
-        cv::cvtColor(frame.color, keypoints.gray, cv::COLOR_BGR2GRAY);
-        keypoints.mask = mask.clone();
-      }
+    if (followsKeypoints()) {
+      keypoints.gray = gray;
+      keypoints.mask = mask.clone();
     }
     return keypoints;
+  }
+
+  /// The frame's grey image, made once per frame where followsKeypoints() (else empty).
+  const cv::Mat& grayOf(FrameContext& ctx) const {
+    if (ctx.gray.empty() && followsKeypoints()) cv::cvtColor(ctx.frame.color, ctx.gray, cv::COLOR_BGR2GRAY);
+    return ctx.gray;
   }
 
   /// What the next frame is tracked from: the last frame that was not lost, and the last good
@@ -195,7 +207,8 @@ class Tracker {
       return false;
     clock_.enter(&StageTimings::features);
     FollowedFeatures followed;
-    if constexpr (FollowingSource<Correspondences>) followed = correspondences_.follow(last.gray, last.mask, last.features, ctx.masked);
+    if constexpr (FollowingSource<Correspondences>)
+      followed = correspondences_.follow(last.gray, last.mask, last.features, ctx.masked, grayOf(ctx));
     const auto estimate = clock_.measure(&StageTimings::ransac, [&] {
       return registration_.estimate(last.features, followed.features, followed.matches);
     });
@@ -443,7 +456,10 @@ class Tracker {
   /// term alone often holds the pose, and the verification below catches it when it does not.
   void optimiseGraph(FrameContext& ctx) {
     clock_.enter(&StageTimings::solve);
-    ctx.optimisation = optimizePoseGraph(energy_.over(ctx.graph), solver_, ctx.graph.poses, settings_.gauss_newton);
+    if constexpr (requires { energy_.over(ctx.graph, &linearisations_); })
+      ctx.optimisation = optimizePoseGraph(energy_.over(ctx.graph, &linearisations_), solver_, ctx.graph.poses, settings_.gauss_newton);
+    else
+      ctx.optimisation = optimizePoseGraph(energy_.over(ctx.graph), solver_, ctx.graph.poses, settings_.gauss_newton);
   }
 
   /// The graph's result when the verifier trusts it (the keyframes take their optimised poses
@@ -487,10 +503,13 @@ class Tracker {
         ctx.current.features = std::move(ctx.features);
         clock_.enter(&StageTimings::graph);
       }
-      if (const int evicted = pool_.add(ctx.current); evicted >= 0) cache_.forget(evicted);
+      if (const int evicted = pool_.add(ctx.current); evicted >= 0) {
+        cache_.forget(evicted);
+        linearisations_.forget(evicted);
+      }
     }
     KeypointFrame keypoints = ctx.keypoints_detected || ctx.keypoints_followed
-                                  ? keypointFrame(ctx.id, ctx.result.T_cam_obj, std::move(ctx.current.features), ctx.frame,
+                                  ? keypointFrame(ctx.id, ctx.result.T_cam_obj, std::move(ctx.current.features), grayOf(ctx),
                                                   ctx.masked.mask, ctx.keypoints_detected ? 0 : ctx.chain_start)
                                   : std::move(last_->keypoints);
     last_ = LastGood{ctx.id, ctx.result.T_cam_obj, ctx.current.surface, std::move(keypoints)};
@@ -516,6 +535,7 @@ class Tracker {
   Verifier verifier_;
   KeyframePool pool_;
   CorrespondenceCache cache_;
+  EdgeLinearisationCache linearisations_;  ///< edges between keyframes, relinearised lazily (settings_.relinearisation)
   std::optional<LastGood> last_;
   StageClock clock_;
   int grid_step_ = 1;  ///< of every surface grid of this track (chosen at initialize)

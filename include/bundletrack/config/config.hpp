@@ -220,6 +220,8 @@ inline std::vector<ConfigEntry> configEntries(Config& c) {
        "none: every Gauss-Newton step is taken (paper); levenberg_marquardt: damped, a step that raises the energy is rejected"},
       {"solver", "min_translation_step", &t.gauss_newton.min_translation_step, 0.0, 1.0, "m", "Gauss-Newton stops when no node moves more ..."},
       {"solver", "min_rotation_step", &t.gauss_newton.min_rotation_step, 0.0, 1.0, "rad", "... and none turns more"},
+      {"solver", "relinearise_translation", &t.relinearisation.max_translation, 0.0, 1.0, "m", "an edge between keyframes is linearised again once one moved this far since ... (0 and 0: every step, as the paper)"},
+      {"solver", "relinearise_rotation", &t.relinearisation.max_rotation, 0.0, 3.2, "rad", "... or turned this far"},
       {"solver", "pcg_max_iterations", &c.pcg.max_iterations, 1, 100000, "", "PCG iterations per step (original code: 5)"},
       {"solver", "pcg_tolerance", &c.pcg.tolerance, 0.0, 1.0, "", "PCG stops at this relative residual (the GPU's float PCG at 1e-6 at the least)"},
       {"masks", "source", textChoice(c.masks, {"given", "propagated"}), 0, 0, "",

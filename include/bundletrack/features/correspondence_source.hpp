@@ -21,13 +21,13 @@ concept CorrespondenceSource = requires(T& source, const T& const_source, const 
 };
 
 /// A correspondence source that can also follow the last frame's keypoints (on its grey image and
-/// object mask) into the next frame, cheaper than detecting and matching them (Tracker: keypoints
-/// on demand).
+/// object mask) into the next frame (given with its grey image, which the tracker keeps for the
+/// frame after), cheaper than detecting and matching them (Tracker: keypoints on demand).
 template <typename T>
 concept FollowingSource = CorrespondenceSource<T> && requires(const T& source, const cv::Mat& last_gray,
                                                                const cv::Mat& last_mask, const FrameFeatures& last,
-                                                               const RgbdFrame& frame) {
-  { source.follow(last_gray, last_mask, last, frame) } -> std::same_as<FollowedFeatures>;
+                                                               const RgbdFrame& frame, const cv::Mat& gray) {
+  { source.follow(last_gray, last_mask, last, frame, gray) } -> std::same_as<FollowedFeatures>;
 };
 
 }  // namespace bundletrack

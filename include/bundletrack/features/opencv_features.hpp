@@ -64,10 +64,10 @@ class OpenCvFeatureSource {
   }
 
   /// The keypoints of the frame before (`last`, on its grey image and object mask) found in
-  /// `frame` by optical flow, lifted as detected ones are (followFeatures).
+  /// `frame` (grey image `gray`) by optical flow, lifted as detected ones are (followFeatures).
   FollowedFeatures follow(const cv::Mat& last_gray, const cv::Mat& last_mask, const FrameFeatures& last,
-                          const RgbdFrame& frame) const {
-    return followFeatures(last_gray, last_mask, last, frame, flow_, crop_.normal_radius, crop_.normal_max_depth_jump);
+                          const RgbdFrame& frame, const cv::Mat& gray) const {
+    return followFeatures(last_gray, last_mask, last, frame, gray, flow_, crop_.normal_radius, crop_.normal_max_depth_jump);
   }
 
  protected:

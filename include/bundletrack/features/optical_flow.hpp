@@ -24,7 +24,7 @@ struct FlowSettings {
 };
 
 /// Follows `last`'s keypoints (on `last_gray`, the grey image of the frame they were detected or
-/// followed on, and `last_mask`, that frame's object mask) into `frame` by pyramidal Lucas-Kanade
+/// followed on, and `last_mask`, that frame's object mask) into `frame` (grey image `gray`) by pyramidal Lucas-Kanade
 /// within the box around both the keypoints and `frame`'s mask (the region the object is searched
 /// in), grown by the flow window. Only keypoints whose whole window lies on the object are
 /// followed: a window that takes in background, which moves otherwise, drags the point along
@@ -33,12 +33,13 @@ struct FlowSettings {
 /// and a normal there (liftKeypoints with `normal_radius` and `normal_max_depth_jump`, as the
 /// detector lifts).
 inline FollowedFeatures followFeatures(const cv::Mat& last_gray, const cv::Mat& last_mask, const FrameFeatures& last,
-                                       const RgbdFrame& frame, const FlowSettings& settings, int normal_radius,
-                                       float normal_max_depth_jump) {
+                                       const RgbdFrame& frame, const cv::Mat& gray, const FlowSettings& settings,
+                                       int normal_radius, float normal_max_depth_jump) {
   FollowedFeatures followed;
   followed.features.norm_type = last.norm_type;
   const cv::Size size = frame.color.size();
-  if (last.size() == 0 || frame.mask.empty() || last_gray.size() != size || last_mask.size() != size) return followed;
+  if (last.size() == 0 || frame.mask.empty() || last_gray.size() != size || last_mask.size() != size || gray.size() != size)
+    return followed;
   const cv::Rect image({0, 0}, size);
   const int margin = settings.window;
   const cv::Rect around = (cv::boundingRect(last.pixels) | cv::boundingRect(frame.mask)) + cv::Size(2 * margin, 2 * margin) -
@@ -48,9 +49,7 @@ inline FollowedFeatures followFeatures(const cv::Mat& last_gray, const cv::Mat& 
   cv::Mat inner;  // where a window centred lies on the object in the last frame (outside the image counts as off it)
   cv::erode(last_mask(box), inner, cv::getStructuringElement(cv::MORPH_RECT, {settings.window, settings.window}),
             {-1, -1}, 1, cv::BORDER_CONSTANT, cv::Scalar(0));
-  const cv::Mat before = last_gray(box);
-  cv::Mat after;
-  cv::cvtColor(frame.color(box), after, cv::COLOR_BGR2GRAY);
+  const cv::Mat before = last_gray(box), after = gray(box);
   const cv::Point2f offset(float(box.x), float(box.y));
   std::vector<cv::Point2f> start, forward, back;
   std::vector<int> start_from;

@@ -34,6 +34,7 @@ struct FrameContext {
   bool keypoints_detected = false;  ///< on this frame (not always with keypoints on demand)
   bool keypoints_followed = false;  ///< the last good frame's keypoints, followed into this frame (optical flow)
   int chain_start = 0;  ///< then: how many keypoints the chain of followed frames began with
+  cv::Mat gray;  ///< the frame's grey image, once made (following keypoints reads it, and the next frame follows on it)
   std::vector<CoarseEstimate> candidates;  ///< coarse poses to try, in order (several only after lost frames)
   CoarseEstimate coarse;  ///< the one being tried
   Keyframe current;  ///< the frame as a graph node

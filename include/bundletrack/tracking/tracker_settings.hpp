@@ -3,6 +3,7 @@
 #include <cstddef>
 
 #include "bundletrack/core/surface_gate.hpp"
+#include "bundletrack/graph/edge_linearisation_cache.hpp"
 #include "bundletrack/solvers/gauss_newton.hpp"
 
 namespace bundletrack {
@@ -90,6 +91,15 @@ struct TrackerSettings {
   /// a step never falls to GaussNewtonSettings' 1e-7, and the 7 linearisations always ran: on the
   /// default synthetic box the third step already moves nodes by at most 4 um and 0.08 mrad.
   GaussNewtonSettings gauss_newton{.iterations = 7, .min_translation_step = 1e-5, .min_rotation_step = 1e-4};
+  /// An edge between two keyframes keeps its linearisation, moved along its linear model, until a
+  /// keyframe has moved by max_translation or turned by max_rotation since (EdgeLinearisationCache;
+  /// 0: every edge at every step, as the paper). 0.5 mm and 1 mrad move a point 25 cm from the
+  /// keyframe's centre by at most 0.75 mm: about the least noisy preset's depth spread at 0.5 m
+  /// (active stereo, 0.65 mm) and under a pixel there, so a new association would change few pairs
+  /// and the linear model's own error (second order: 1 mrad^2 x 0.25 m = 0.25 um) none. The graph
+  /// then linearises the current frame's K edges per step instead of K (K + 1) / 2; on the default
+  /// box the frame went from 51 to 18 ms, the stress matrix's cells stayed within 0.2 ADD-S.
+  RelinearisationSettings relinearisation{.max_translation = 5e-4, .max_rotation = 1e-3};
 };
 
 }  // namespace bundletrack

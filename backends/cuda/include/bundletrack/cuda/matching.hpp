@@ -38,10 +38,10 @@ class GpuMatched {
 
   /// The Detector's following by optical flow, where it has one (FollowingSource).
   FollowedFeatures follow(const cv::Mat& last_gray, const cv::Mat& last_mask, const FrameFeatures& last,
-                          const RgbdFrame& frame) const
+                          const RgbdFrame& frame, const cv::Mat& gray) const
     requires FollowingSource<Detector>
   {
-    return detector_.follow(last_gray, last_mask, last, frame);
+    return detector_.follow(last_gray, last_mask, last, frame, gray);
   }
 
   std::vector<FeatureMatch> match(const FrameFeatures& first, const FrameFeatures& second,
