@@ -1,6 +1,7 @@
 // Kabsch, RANSAC and matching against exact ground truth.
 #include <doctest/doctest.h>
 
+#include <numeric>
 #include <random>
 
 #include "bundletrack/eval/pose_metrics.hpp"
@@ -246,6 +247,30 @@ TEST_CASE("exhaustive matching and descriptor distances equal OpenCV's brute-for
     CHECK(expected.size() >= 100);  // most of the 120 unambiguous copies
     CHECK(expected.size() <= 125);  // not the 30 ambiguous ones
     CHECK(bt::matchFeatures(a, b, settings) == expected);
+  }
+}
+
+TEST_CASE("the two nearest candidates do not depend on the order they are offered in, ties included") {
+  // Distances with ties (multiples of 0.5 among 12 candidates): in index order the lower index
+  // wins a tie, as cv::BFMatcher; every shuffled order must give the same nearest, its distance and
+  // the second distance.
+  std::mt19937 rng(7);
+  std::uniform_int_distribution<int> halves(1, 6);
+  for (int round = 0; round < 200; ++round) {
+    std::vector<float> distance(12);
+    for (float& d : distance) d = 0.5f * float(halves(rng));
+    bt::TwoNearest in_order;
+    for (int j = 0; j < 12; ++j) in_order.offer(distance[std::size_t(j)], j);
+    std::vector<int> order(12);
+    std::iota(order.begin(), order.end(), 0);
+    std::shuffle(order.begin(), order.end(), rng);
+    bt::TwoNearest shuffled;
+    for (const int j : order) shuffled.offer(distance[std::size_t(j)], j);
+    const auto lowest = std::min_element(distance.begin(), distance.end());
+    REQUIRE(in_order.index == int(lowest - distance.begin()));  // the first of the smallest
+    CHECK(shuffled.index == in_order.index);
+    CHECK(shuffled.best == in_order.best);
+    CHECK(shuffled.second == in_order.second);
   }
 }
 

@@ -1,6 +1,8 @@
 #pragma once
 
+#include <algorithm>
 #include <cmath>
+#include <numeric>
 #include <optional>
 #include <vector>
 
@@ -56,6 +58,9 @@ class GateTest {
     return bounds_.admits((moved.point - second_.points[std::size_t(j)]).squaredNorm(),
                           moved.normal.dot(second_.normals[std::size_t(j)]));
   }
+  /// Farther than this apart along any axis, two points are never admitted (a hair wider than the
+  /// gate's distance, against rounding).
+  float reach() const { return std::sqrt(bounds_.max_squared_distance) * (1.0f + 1e-5f); }
 
  private:
   const MatchGate& gate_;
@@ -91,15 +96,26 @@ inline std::vector<FeatureMatch> mutualMatches(const std::vector<TwoNearest>& fo
 }
 
 /// Guided matching under a known relative pose: mutual nearest neighbours with the ratio test in
-/// both directions, among the pairs the gate admits only. Sorted by the first index.
+/// both directions, among the pairs the gate admits only. Sorted by the first index. Each of
+/// first's keypoints is tested only against second's within the gate's reach in x (second's sorted
+/// by x once; TwoNearest does not depend on the order of its candidates).
 inline std::vector<FeatureMatch> matchGuided(const FrameFeatures& first, const FrameFeatures& second,
                                              const MatchSettings& settings, const MatchGate& gate) {
   const int n1 = int(first.size()), n2 = int(second.size());
   std::vector<TwoNearest> forward(static_cast<std::size_t>(n1)), backward(static_cast<std::size_t>(n2));
   const GateTest test(gate, first, second);
+  std::vector<int> by_x(static_cast<std::size_t>(n2));
+  std::iota(by_x.begin(), by_x.end(), 0);
+  std::sort(by_x.begin(), by_x.end(), [&](int a, int b) { return second.points[std::size_t(a)].x() < second.points[std::size_t(b)].x(); });
+  std::vector<float> sorted_x;
+  for (const int j : by_x) sorted_x.push_back(second.points[std::size_t(j)].x());
+  const float reach = test.reach();
   for (int i = 0; i < n1; ++i) {
     const GateTest::Moved moved = test.move(i);
-    for (int j = 0; j < n2; ++j) {
+    const auto from = std::lower_bound(sorted_x.begin(), sorted_x.end(), moved.point.x() - reach);
+    const auto to = std::upper_bound(from, sorted_x.end(), moved.point.x() + reach);
+    for (auto k = from - sorted_x.begin(); k < to - sorted_x.begin(); ++k) {
+      const int j = by_x[std::size_t(k)];
       if (!test.admits(moved, j)) continue;
       const float distance = descriptorDistance(first.descriptors, i, second.descriptors, j, first.norm_type);
       forward[std::size_t(i)].offer(distance, j);

@@ -13,9 +13,10 @@ struct TwoNearest {
   int index = -1;  ///< of the nearest candidate; -1: none yet
   float best = INFINITY, second = INFINITY;
 
-  /// Candidates come in increasing index order, so a tie keeps the lower index (as cv::BFMatcher).
+  /// A tie keeps the lower index (as cv::BFMatcher, which offers in index order), in whatever order
+  /// the candidates come.
   BUNDLETRACK_HOST_DEVICE void offer(float distance, int candidate) {
-    if (distance < best) second = best, best = distance, index = candidate;
+    if (distance < best || (distance == best && candidate < index)) second = best, best = distance, index = candidate;
     else if (distance < second) second = distance;
   }
   /// Lowe's ratio test; a lone candidate passes.
