@@ -166,8 +166,10 @@ scoring=$("$build/bin/bench_scoring" --benchmark_format=csv 2>/dev/null)
     echo "every method's poses scored by bundletrack_eval. Milliseconds per frame count everything from"
     echo "the image files to the pose on this CPU machine (Open3D $(/usr/bin/python3 -c 'import open3d; print(open3d.__version__)'),"
     echo "Debian build): for Open3D its loop over the frames, for ours the whole bundletrack_track process"
-    echo "(start, first frame and scoring included) over the frame count; \"decoding only\" is OpenCV decoding"
-    echo "the same files. ours / method time < 1 means ours is faster. A failed step keeps the last pose."
+    echo "(start, first frame, writing poses, track.csv and model.ply; run with --no-score, its final ADD / ADD-S"
+    echo "table being evaluation, where the build has the flag: a --before build without it counts its scoring)"
+    echo "over the frame count; \"decoding only\" is OpenCV decoding the same files. ours / method time < 1"
+    echo "means ours is faster. A failed step keeps the last pose."
     echo
     before_args=()
     [ -n "$before" ] && before_args=(--before "$before" --before-label "$before_label")

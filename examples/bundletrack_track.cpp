@@ -68,6 +68,7 @@ struct Options {
   std::string objects;  ///< --objects: names separated by commas, or "all"
   bt::Config config;
   bool quiet = false;
+  bool no_score = false;  ///< --no-score: no ADD / ADD-S table at the end
   bool strict = false;  ///< --strict: a frame that cannot be read stops the run
   bool viz = false;
 };
@@ -508,7 +509,7 @@ void run(bt::MultiObjectTracker& tracker, const bt::io::RgbdSequence& sequence, 
                 per_frame, 1000.0 / per_frame);
   }
   std::vector<bt::NamedScore> rows;
-  for (std::size_t k = 0; k < count; ++k)
+  for (std::size_t k = 0; k < count && !options.no_score; ++k)
     outputs[k]->scoreRows(several ? objects[k] : options.sequence.filename().string(), rows);
   if (!rows.empty()) {
     std::printf("%s", bt::formatScoreTable(rows, bt::MeanRow::Omit).c_str());  // views of one run, objects apart: no mean
@@ -591,6 +592,9 @@ int main(int argc, char** argv) {
                                                         "errors.png), the overlay shows them all")
       ->type_name("LIST");
   command_line.add_flag("--quiet", options.quiet, "no progress line");
+  command_line.add_flag("--no-score", options.no_score,
+                        "no ADD / ADD-S table at the end (track.csv keeps each frame's errors; bundletrack_eval\n"
+                        "scores the poses later): the run's time is then files to poses alone");
   command_line.parseOrExit(argc, argv);
   if (print_config_table) {
     std::cout << bt::settingsTable();

@@ -15,7 +15,7 @@ for option in --out --frames --shape --size --distance --sensor --out-of-view --
   grep -q -- "$option" "$work/help.txt" || fail "bundletrack_synth --help does not list $option"
 done
 "$track" --help > "$work/help.txt" || fail "bundletrack_track --help: exit $?"
-for option in --sequence --out --config --features --min-inliers --sensor --propagate-masks --strict --objects --quiet; do
+for option in --sequence --out --config --features --min-inliers --sensor --propagate-masks --strict --objects --quiet --no-score; do
   grep -q -- "$option" "$work/help.txt" || fail "bundletrack_track --help does not list $option"
 done
 "$eval" --help | grep -q -- "--in-view" || fail "bundletrack_eval --help does not list --in-view"
@@ -58,4 +58,9 @@ refused "--every: expects a whole number >= 1, got '0'" "$inspect" --sequence "$
 "$track" --sequence "$work/seq" --out "$work/out" --quiet --features orb --min-inliers 6 > "$work/summary.txt" ||
   fail "a well-formed bundletrack_track command line failed"
 [ "$(ls "$work/out/poses" | wc -l)" -eq 3 ] || fail "not one pose per frame"
+grep -q "ADD-S" "$work/summary.txt" || fail "no score table for a sequence with ground truth"
+"$track" --sequence "$work/seq" --out "$work/unscored" --quiet --no-score > "$work/unscored.txt" ||
+  fail "bundletrack_track --no-score failed"
+if grep -q "ADD-S" "$work/unscored.txt"; then fail "--no-score still printed the score table"; fi
+[ "$(ls "$work/unscored/poses" | wc -l)" -eq 3 ] || fail "--no-score: not one pose per frame"
 echo "command lines: help, refusals and well-formed runs as expected"
