@@ -100,6 +100,14 @@ std::vector<bt::SE3d> fourViews() {
   return views;
 }
 
+/// Keyframes of the patch seen from `views`, on a 150 px grid camera.
+std::vector<bt::Keyframe> patchKeyframes(const std::vector<bt::SE3d>& views) {
+  const bt::PinholeCameraf grid{150.0f, 150.0f, 39.5f, 29.5f};
+  std::vector<bt::Keyframe> frames;
+  for (std::size_t k = 0; k < views.size(); ++k) frames.push_back(surfaceKeyframe(int(k), views[k], grid));
+  return frames;
+}
+
 /// The CPU dense term behind the batch interface, recording the size of every batch it is given.
 struct BatchedDense {
   bt::DensePointToPlane dense;
@@ -211,10 +219,8 @@ TEST_CASE("PCG and dense LDLT give the same update on a pose-graph system") {
 
 TEST_CASE("Gauss-Newton brings perturbed poses back to the truth, node 0 fixed, with and without step control") {
   std::mt19937 rng(5);
-  const bt::PinholeCameraf grid{150.0f, 150.0f, 39.5f, 29.5f};
   const std::vector<bt::SE3d> truth = fourViews();
-  std::vector<bt::Keyframe> frames;
-  for (int k = 0; k < 4; ++k) frames.push_back(surfaceKeyframe(k, truth[std::size_t(k)], grid));
+  const std::vector<bt::Keyframe> frames = patchKeyframes(truth);
   // Features correspond by index (the same grid cells see nearby, not identical, points), so only
   // the dense term is used here; it is exact up to the grid's sampling.
   const std::vector<bt::FeatureMatch> none;
@@ -334,10 +340,8 @@ TEST_CASE("a kept edge system moved along its linear model equals the system of 
 
 TEST_CASE("lazy relinearisation: edges between pool keyframes are linearised again only when a keyframe has moved") {
   std::mt19937 rng(5);
-  const bt::PinholeCameraf grid{150.0f, 150.0f, 39.5f, 29.5f};
   const std::vector<bt::SE3d> truth = fourViews();
-  std::vector<bt::Keyframe> frames;
-  for (int k = 0; k < 4; ++k) frames.push_back(surfaceKeyframe(k, truth[std::size_t(k)], grid));
+  const std::vector<bt::Keyframe> frames = patchKeyframes(truth);
   const std::vector<bt::FeatureMatch> none;
   std::vector<bt::SE3d> start = truth;
   for (int k = 1; k < 4; ++k) start[k] = perturbed(truth[k], rng, k < 3 ? 2e-4 : 0.004);  // keyframes settled, the frame not
