@@ -388,6 +388,7 @@ class Tracker {
     if (features) ctx.features = *features;
     ctx.coarse = coarse;
     if (!segmentObject(ctx)) return false;
+    ctx.coarse_evidence = ctx.coarse.last_inliers;  // buildGraph may move them into an edge
     makeNode(ctx);
     buildGraph(ctx);
     optimiseGraph(ctx);
@@ -462,10 +463,31 @@ class Tracker {
       ctx.optimisation = optimizePoseGraph(energy_.over(ctx.graph), solver_, ctx.graph.poses, settings_.gauss_newton);
   }
 
-  /// The graph's result when the verifier trusts it (the keyframes take their optimised poses
-  /// too), else the coarse pose, unless there is none or the track is being re-acquired.
+  /// The graph refines the coarse pose; it may not throw away the evidence behind it. Where RANSAC
+  /// found the coarse pose with the last good frame on recovery_min_inliers or more inliers (more
+  /// than chance gathers), the graph's pose must keep min_kept_coarse_inliers of them within the
+  /// edge gate. A box turned by 90 degrees can agree with the keyframes' surfaces (the verifier
+  /// alone accepted such a pose on a 1,500-frame run of the default motion, after the graph had
+  /// diverged from 239 followed keypoints); it cannot keep its own feature pairs.
+  bool keepsCoarseEvidence(const FrameContext& ctx) const {
+    const std::vector<FeatureMatch>& inliers = ctx.coarse_evidence;
+    if (!ctx.coarse.from_last || int(inliers.size()) < settings_.recovery_min_inliers) return true;
+    const KeypointFrame& last = last_->keypoints;
+    const FrameFeatures& current = ctx.current.features;
+    const SurfaceGate gate = settings_.edge_gate.widened(NoiseScale::between(last.features.noise_scale, current.noise_scale));
+    const SE3d T_current_last = ctx.graph.poses.back() * last.T_cam_obj.inverse();
+    const MatchGate under_graph{T_current_last.cast<float>(), gate};  // GateTest keeps a reference
+    const GateTest test(under_graph, last.features, current);
+    int kept = 0;
+    for (const FeatureMatch& m : inliers) kept += test.admits(test.move(m.first), m.second);
+    return kept >= settings_.min_kept_coarse_inliers * double(inliers.size());
+  }
+
+  /// The graph's result when the verifier trusts it and it keeps its coarse evidence (the keyframes
+  /// take their optimised poses too), else the coarse pose, unless there is none or the track is
+  /// being re-acquired.
   bool acceptPose(FrameContext& ctx) {
-    if (verifier_.accepts(ctx.graph, ctx.coarse.evidence)) {
+    if (verifier_.accepts(ctx.graph, ctx.coarse.evidence) && keepsCoarseEvidence(ctx)) {
       for (std::size_t n = 0; n < ctx.graph.pool_indices.size(); ++n)
         pool_[ctx.graph.pool_indices[n]].T_cam_obj = ctx.graph.poses[n];
       ctx.result.T_cam_obj = ctx.graph.poses.back();

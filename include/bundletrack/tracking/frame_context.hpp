@@ -37,6 +37,7 @@ struct FrameContext {
   cv::Mat gray;  ///< the frame's grey image, once made (following keypoints reads it, and the next frame follows on it)
   std::vector<CoarseEstimate> candidates;  ///< coarse poses to try, in order (several only after lost frames)
   CoarseEstimate coarse;  ///< the one being tried
+  std::vector<FeatureMatch> coarse_evidence;  ///< its inliers with the last good frame (the graph may take coarse's)
   Keyframe current;  ///< the frame as a graph node
   cv::Mat current_mask;  ///< the mask `current`'s grid and images were made under (its buffer kept: no other mask shares it)
   PoseGraph graph;

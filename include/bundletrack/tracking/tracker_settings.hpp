@@ -44,6 +44,11 @@ struct TrackerSettings {
   /// Without a motion prior a handful of inliers can be chance: on the synthetic box, 5 of 12
   /// matches gave a pose 172 degrees off; 12 is well above what random matches gather.
   int recovery_min_inliers = 12;
+  /// A graph result must keep this share of the coarse pose's RANSAC inliers with the last good
+  /// frame within edge_gate, where there are recovery_min_inliers or more (Tracker's
+  /// keepsCoarseEvidence): a half, as followed keypoints must keep (follow_min_share); a graph that
+  /// refines the pose by millimetres keeps nearly all, one that diverged keeps none.
+  double min_kept_coarse_inliers = 0.5;
   /// A frame that features cannot re-acquire (a textureless object, a far one with 3-5 inliers) is
   /// re-acquired by its surface: the graph runs from each of at most this many coarse poses --
   /// registrations with min_inliers or more inliers (most first), the last good pose, and the last
