@@ -21,6 +21,7 @@
 
 #include "command_line.hpp"
 
+#include "bundletrack/core/frame_memory.hpp"
 #include "bundletrack/io/read_ahead.hpp"
 #include "bundletrack/io/rgbd_sequence.hpp"
 #include "bundletrack/runtime/make_tracker.hpp"
@@ -177,6 +178,7 @@ void run(const std::string& name, const bt::PinholeCameraf& camera, std::size_t 
 }  // namespace
 
 int main(int argc, char** argv) {
+  bt::keepFreedFrameMemory();  // frames allocate image-sized buffers: no page faults for each
   Options options;
   bt::examples::CommandLine command_line(
       "The default tracker's time per stage (medians and 90th percentiles) on sequences from files, or on\n"

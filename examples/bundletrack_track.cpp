@@ -25,6 +25,7 @@
 #include "command_line.hpp"
 
 #include "bundletrack/config/config_file.hpp"
+#include "bundletrack/core/frame_memory.hpp"
 #include "bundletrack/eval/mask_iou.hpp"
 #include "bundletrack/eval/pose_metrics.hpp"
 #include "bundletrack/eval/score_table.hpp"
@@ -530,6 +531,7 @@ void writeText(const fs::path& path, const std::string& text) { std::ofstream(pa
 }  // namespace
 
 int main(int argc, char** argv) {
+  bt::keepFreedFrameMemory();  // frames allocate image-sized buffers: no page faults for each
   Options options;
   fs::path incomplete;  // OUT/INCOMPLETE once the output exists
   bool print_config = false, print_config_table = false, propagate_masks = false, gpu = false;

@@ -2,12 +2,16 @@
 #include <doctest/doctest.h>
 
 #include <cmath>
+#include <cstdlib>
+#include <cstring>
 #include <limits>
 #include <random>
 
+#include "bundletrack/core/frame_memory.hpp"
 #include "bundletrack/core/intensity_image.hpp"
 #include "bundletrack/core/rgbd_frame.hpp"
 #include "bundletrack/core/se3.hpp"
+#include "bundletrack/core/surface_grid.hpp"
 
 namespace bt = bundletrack;
 
@@ -188,6 +192,19 @@ TEST_CASE("a frame preprocessed inside a region equals the whole image's preproc
       image.copyTo(left, outside);
       CHECK(cv::countNonZero(left.reshape(1)) == 0);
     }
+    // The surface grid of a mask inside the region visits only the region's cells (odd offsets:
+    // the first cell at or after the region's first pixel) and equals the whole frame's.
+    cv::Mat mask = cv::Mat::zeros(size, CV_8UC1);
+    mask(inside).setTo(255);
+    for (const int step : {1, 2, 3}) {
+      const bt::SurfaceGrid from_part = bt::sampleSurface(part, mask, kCamera, step);
+      const bt::SurfaceGrid from_whole = bt::sampleSurface(whole, mask, kCamera, step);
+      CAPTURE(step);
+      CHECK(from_part.cells.size() > std::size_t(inside.area() / (4 * step * step)));  // not empty: a tenth are holes
+      CHECK(from_part.cells == from_whole.cells);
+      CHECK(cv::norm(from_part.points, from_whole.points, cv::NORM_INF) == 0.0);
+      CHECK(cv::norm(from_part.normals, from_whole.normals, cv::NORM_INF) == 0.0);
+    }
   }
 }
 
@@ -249,3 +266,17 @@ TEST_CASE("the intensity image drops shading and the background and holds each g
   CHECK(next == sampled.cells.size());
   CHECK(next > 200);
 }
+
+#if defined(__GLIBC__) && !defined(__SANITIZE_ADDRESS__)  // the sanitizers' allocator has no mallinfo2
+TEST_CASE("keepFreedFrameMemory serves a frame-sized block from the heap and keeps it when freed") {
+  REQUIRE(bt::keepFreedFrameMemory());
+  constexpr std::size_t kBlock = 16 << 20;  // two 640x480 point images
+  const struct mallinfo2 before = mallinfo2();
+  void* block = std::malloc(kBlock);
+  REQUIRE(block != nullptr);
+  std::memset(block, 1, kBlock);
+  CHECK(mallinfo2().hblks == before.hblks);  // not a block of its own pages (mmap)
+  std::free(block);
+  CHECK(mallinfo2().fordblks >= kBlock);  // its memory stays free in the heap for the next frame
+}
+#endif

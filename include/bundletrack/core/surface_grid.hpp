@@ -45,22 +45,27 @@ inline int gridStepFor(const RgbdFrame& frame, const cv::Mat& mask, int target, 
   return std::clamp(step, 1, std::max(1, max_step));
 }
 
-/// Samples the masked surface of `frame` every `step` pixels.
+/// Samples the masked surface of `frame` every `step` pixels. Only the cells inside the frame's
+/// region are visited: outside it the frame has no points (makeFrame), so those cells stay zero.
 inline SurfaceGrid sampleSurface(const RgbdFrame& frame, const cv::Mat& mask, const PinholeCameraf& camera, int step) {
   SurfaceGrid grid;
   grid.camera = downsampledCamera(camera, step);
   grid.step = step;
   const cv::Size size((frame.points.cols + step - 1) / step, (frame.points.rows + step - 1) / step);
-  grid.points.create(size, CV_32FC3);
-  grid.normals.create(size, CV_32FC3);
-  for (int y = 0; y < size.height; ++y) {
-    for (int x = 0; x < size.width; ++x) {
-      const int u = step * x, v = step * y;
-      const cv::Vec3f& n = frame.normals.at<cv::Vec3f>(v, u);
-      const bool use = mask.at<uchar>(v, u) && frame.points.at<cv::Vec3f>(v, u)[2] > 0.0f && n[2] != 0.0f;
-      grid.points.at<cv::Vec3f>(y, x) = use ? frame.points.at<cv::Vec3f>(v, u) : cv::Vec3f(0, 0, 0);
-      grid.normals.at<cv::Vec3f>(y, x) = use ? n : cv::Vec3f(0, 0, 0);
-      if (!use) continue;
+  grid.points = cv::Mat::zeros(size, CV_32FC3);
+  grid.normals = cv::Mat::zeros(size, CV_32FC3);
+  const cv::Rect region = frame.region.area() > 0 ? frame.region : cv::Rect({0, 0}, frame.points.size());
+  const auto firstCell = [step](int pixel) { return (pixel + step - 1) / step; };  // first cell at or after a pixel
+  for (int y = firstCell(region.y); y < firstCell(region.br().y); ++y) {
+    const int v = step * y;
+    const auto* points = frame.points.ptr<cv::Vec3f>(v);
+    const auto* normals = frame.normals.ptr<cv::Vec3f>(v);
+    const uchar* on_object = mask.ptr<uchar>(v);
+    for (int x = firstCell(region.x); x < firstCell(region.br().x); ++x) {
+      const int u = step * x;
+      if (!on_object[u] || points[u][2] <= 0.0f || normals[u][2] == 0.0f) continue;
+      grid.points.at<cv::Vec3f>(y, x) = points[u];
+      grid.normals.at<cv::Vec3f>(y, x) = normals[u];
       grid.cells.emplace_back(x, y);
       if (!frame.color.empty()) grid.colors.push_back(frame.color.at<cv::Vec3b>(v, u));
     }
