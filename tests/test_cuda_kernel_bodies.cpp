@@ -62,7 +62,7 @@ bt::PairSystem denseOnHost(const bt::DensePointToPlane::Input& in, const bt::SE3
   bt::PairSystem system;
   const auto pass = [&](const bt::SurfaceGrid& s, const bt::SurfaceGrid& t, const bt::SE3d& T_s, const bt::SE3d& T_t,
                         bool swapped) {
-    const detail::DirectedPass p = detail::directedPass(T_s, T_t, t.camera, gates.gate, parameters, weight);
+    const detail::DirectedPass p = detail::directedPass(T_s, T_t, t, gates.gate, parameters, weight);
     double sums[detail::kDenseSums] = {};
     for (const int cell : detail::surfaceCells(s))
       detail::addDenseCell(s.points.ptr<float>(), s.normals.ptr<float>(), cell, t.points.ptr<float>(),

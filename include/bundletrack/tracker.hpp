@@ -324,7 +324,7 @@ class Tracker {
     if (seen.cells.empty()) return std::nullopt;
     Eigen::Vector3d before = Eigen::Vector3d::Zero(), now = Eigen::Vector3d::Zero();
     for (const cv::Point& cell : seen.cells) {
-      const cv::Vec3f& p = seen.points.at<cv::Vec3f>(cell);
+      const cv::Vec3f& p = seen.point(cell);
       before += Eigen::Vector3d(p[0], p[1], p[2]);
     }
     before /= double(seen.cells.size());

@@ -28,6 +28,7 @@ BUNDLETRACK_HOST_DEVICE inline void addDenseCell(const float* s_points, const fl
   applyRigid(pass.T_t_s, p_s, in_t);
   int u = 0, v = 0;
   if (!projectToPixel(pass.fx, pass.fy, pass.cx, pass.cy, in_t[0], in_t[1], in_t[2], u, v)) return;
+  u -= pass.origin_x, v -= pass.origin_y;  // the cell in t's stored box
   if (u < 0 || v < 0 || u >= t_width || v >= t_height) return;
   const int at = v * t_width + u;
   if (t_points[3 * at + 2] <= 0.0f) return;

@@ -15,11 +15,12 @@ DeviceGrid* uploadGrid(const float* points, const float* normals, int width, int
 void releaseGrid(DeviceGrid* grid);
 
 /// One direction s -> t of an edge: rigid maps as row-major 3x4 [R | t] in double, the gates and
-/// the grid camera, and the robust loss.
+/// the grid camera with the grid cell of t's first stored point, and the robust loss.
 struct DirectedPass {
   double T_t_s[12], T_s_t[12], T_s_inv[12], T_t_inv[12];
   double cos_max, max_sq;
   float fx, fy, cx, cy;  ///< t's grid camera
+  int origin_x, origin_y;  ///< t's SurfaceGrid::origin
   LossParameters loss;
   double weight;
 };

@@ -17,8 +17,8 @@ inline void rowMajor3x4(const SE3d& T, double out[12]) {
 }
 
 /// The pass s -> t of an edge whose nodes have poses T_s, T_t (object in camera), with the gate of
-/// DensePointToPlane and t's grid camera.
-inline DirectedPass directedPass(const SE3d& T_s, const SE3d& T_t, const PinholeCameraf& t_camera, const SurfaceGate& gate,
+/// DensePointToPlane and t's grid camera and origin.
+inline DirectedPass directedPass(const SE3d& T_s, const SE3d& T_t, const SurfaceGrid& t, const SurfaceGate& gate,
                                  const LossParameters& loss, double weight) {
   DirectedPass p{};
   rowMajor3x4(T_t * T_s.inverse(), p.T_t_s);
@@ -28,7 +28,8 @@ inline DirectedPass directedPass(const SE3d& T_s, const SE3d& T_t, const Pinhole
   const SurfaceGate::Bounds<double> bounds = gate.bounds<double>();
   p.cos_max = bounds.cos_max_angle;
   p.max_sq = bounds.max_squared_distance;
-  p.fx = t_camera.fx, p.fy = t_camera.fy, p.cx = t_camera.cx, p.cy = t_camera.cy;
+  p.fx = t.camera.fx, p.fy = t.camera.fy, p.cx = t.camera.cx, p.cy = t.camera.cy;
+  p.origin_x = t.origin.x, p.origin_y = t.origin.y;
   p.loss = loss;
   p.weight = weight;
   return p;
@@ -42,10 +43,13 @@ inline void addPassSums(const double sums[kDenseSums], bool swapped, PairSystem&
                          sums[42], int(sums[43] + 0.5));
 }
 
-/// Row-major indices of a grid's surface cells.
+/// Row-major indices of a grid's surface cells in its stored box.
 inline std::vector<int> surfaceCells(const SurfaceGrid& grid) {
   std::vector<int> cells(grid.cells.size());
-  for (std::size_t i = 0; i < cells.size(); ++i) cells[i] = grid.cells[i].y * grid.points.cols + grid.cells[i].x;
+  for (std::size_t i = 0; i < cells.size(); ++i) {
+    const cv::Point local = grid.cells[i] - grid.origin;
+    cells[i] = local.y * grid.points.cols + local.x;
+  }
   return cells;
 }
 

@@ -24,11 +24,11 @@ std::uint64_t signature(const SurfaceGrid& k) {
   };
   const void* data = k.points.data;
   mix(&data, sizeof(data));
-  const int sizes[3] = {k.points.rows, k.points.cols, int(k.cells.size())};
+  const int sizes[5] = {k.points.rows, k.points.cols, k.origin.x, k.origin.y, int(k.cells.size())};
   mix(sizes, sizeof(sizes));
   const std::size_t n = k.cells.size(), ends = std::min<std::size_t>(n, 16);
-  for (std::size_t i = 0; i < ends; ++i) mix(&k.points.at<cv::Vec3f>(k.cells[i]), sizeof(cv::Vec3f));
-  for (std::size_t i = n - ends; i < n; ++i) mix(&k.points.at<cv::Vec3f>(k.cells[i]), sizeof(cv::Vec3f));
+  for (std::size_t i = 0; i < ends; ++i) mix(&k.point(k.cells[i]), sizeof(cv::Vec3f));
+  for (std::size_t i = n - ends; i < n; ++i) mix(&k.point(k.cells[i]), sizeof(cv::Vec3f));
   return h;
 }
 
@@ -106,8 +106,8 @@ void DensePointToPlane::lineariseAllWith(std::span<const Input> inputs, std::spa
     const SurfaceGate widened = gate.widened(NoiseScale::between(in.i.noise_scale, in.j.noise_scale));
     const double weight_i = weight * bundletrack::DensePointToPlane::sampleWeight(in.i);
     const double weight_j = weight * bundletrack::DensePointToPlane::sampleWeight(in.j);
-    w.passes.push_back({grid_i, grid_j, detail::directedPass(T_i, T_j, in.j.camera, widened, loss, weight_i)});
-    w.passes.push_back({grid_j, grid_i, detail::directedPass(T_j, T_i, in.i.camera, widened, loss, weight_j)});
+    w.passes.push_back({grid_i, grid_j, detail::directedPass(T_i, T_j, in.j, widened, loss, weight_i)});
+    w.passes.push_back({grid_j, grid_i, detail::directedPass(T_j, T_i, in.i, widened, loss, weight_j)});
   }
   w.sums.resize(w.passes.size() * detail::kDenseSums);
   detail::accumulateDense(*w.batch, w.passes.data(), int(w.passes.size()), w.sums.data());

@@ -37,7 +37,7 @@ inline std::vector<ModelPoint> fuseObjectModel(const KeyframePool& pool, const O
     for (std::size_t k = 0; k < pool.size(); ++k) {
       const SurfaceGrid& grid = pool[k].surface;
       std::vector<float> depths;
-      for (const cv::Point& cell : grid.cells) depths.push_back(grid.points.at<cv::Vec3f>(cell)[2]);
+      for (const cv::Point& cell : grid.cells) depths.push_back(grid.point(cell)[2]);
       if (depths.empty()) continue;
       std::nth_element(depths.begin(), depths.begin() + std::ptrdiff_t(depths.size() / 2), depths.end());
       spacings.push_back(depths[depths.size() / 2] / grid.camera.fx);
@@ -60,8 +60,8 @@ inline std::vector<ModelPoint> fuseObjectModel(const KeyframePool& pool, const O
     const SurfaceGrid& grid = pool[k].surface;
     const SE3f T_obj_cam = pool[k].T_cam_obj.inverse().cast<float>();
     for (std::size_t c = 0; c < grid.cells.size(); ++c) {
-      const cv::Vec3f& p = grid.points.at<cv::Vec3f>(grid.cells[c]);
-      const cv::Vec3f& n = grid.normals.at<cv::Vec3f>(grid.cells[c]);
+      const cv::Vec3f& p = grid.point(grid.cells[c]);
+      const cv::Vec3f& n = grid.normal(grid.cells[c]);
       const Eigen::Vector3f position = T_obj_cam * Eigen::Vector3f(p[0], p[1], p[2]);
       Sum& sum = voxels[key(position)];
       sum.position += position.cast<double>();

@@ -73,14 +73,14 @@ struct DensePhotometric {
     for (const IntensityImage::CellIntensity& sampled : image_s.cells) {
       const cv::Point& cell = s.cells[std::size_t(sampled.cell)];
       const double brightness_s = sampled.intensity;
-      const cv::Vec3f& ps = s.points.at<cv::Vec3f>(cell);
+      const cv::Vec3f& ps = s.point(cell);
       const Eigen::Vector3d p_s(ps[0], ps[1], ps[2]), q = T_t_s * p_s;
       int u = 0, v = 0;
       if (!t.camera.pixelOf(q, u, v) || !t.inside(u, v)) continue;
-      const cv::Vec3f& pt = t.points.at<cv::Vec3f>(v, u);
+      const cv::Vec3f& pt = t.point(u, v);
       if (pt[2] <= 0.0f || (Eigen::Vector3d(pt[0], pt[1], pt[2]) - q).squaredNorm() > bounds.max_squared_distance) continue;
-      const cv::Vec3f& ns = s.normals.at<cv::Vec3f>(cell);
-      const cv::Vec3f& nt = t.normals.at<cv::Vec3f>(v, u);
+      const cv::Vec3f& ns = s.normal(cell);
+      const cv::Vec3f& nt = t.normal(u, v);
       const Eigen::Vector3d n_q = R_t_s * Eigen::Vector3d(ns[0], ns[1], ns[2]);
       if (n_q.dot(q) >= 0.0 || n_q.dot(Eigen::Vector3d(nt[0], nt[1], nt[2])) < bounds.cos_max_angle) continue;
       const double iz = 1.0 / q.z();

@@ -51,16 +51,16 @@ struct DensePointToPlane {
     const Eigen::Matrix3d R_s_inv = T_s_inv.linear(), R_s_t = T_s_t.linear();
     const SurfaceGate::Bounds<double> bounds = gate.widened(NoiseScale::between(s.noise_scale, t.noise_scale)).bounds<double>();
     for (const cv::Point& cell : s.cells) {
-      const cv::Vec3f& ps = s.points.at<cv::Vec3f>(cell);
+      const cv::Vec3f& ps = s.point(cell);
       const Eigen::Vector3d p_s(ps[0], ps[1], ps[2]);
       int u = 0, v = 0;
       if (!t.camera.pixelOf(T_t_s * p_s, u, v) || !t.inside(u, v)) continue;
-      const cv::Vec3f& pt = t.points.at<cv::Vec3f>(v, u);
+      const cv::Vec3f& pt = t.point(u, v);
       if (pt[2] <= 0.0f) continue;
       const Eigen::Vector3d p_t(pt[0], pt[1], pt[2]);
       if ((T_s_t * p_t - p_s).squaredNorm() > bounds.max_squared_distance) continue;  // the cheap test first
-      const cv::Vec3f& ns = s.normals.at<cv::Vec3f>(cell);
-      const cv::Vec3f& nt = t.normals.at<cv::Vec3f>(v, u);
+      const cv::Vec3f& ns = s.normal(cell);
+      const cv::Vec3f& nt = t.normal(u, v);
       const Eigen::Vector3d n_s(ns[0], ns[1], ns[2]);
       if ((R_s_t * Eigen::Vector3d(nt[0], nt[1], nt[2])).dot(n_s) < bounds.cos_max_angle) continue;
       const Eigen::Vector3d m = R_s_inv * n_s, a = T_s_inv * p_s, b = T_t_inv * p_t;

@@ -34,25 +34,25 @@ inline double geometricStability(const SurfaceGrid& surface, int radius = -1) {
   Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
   cv::Rect box(surface.cells.front(), cv::Size(1, 1));
   for (const cv::Point& cell : surface.cells) {
-    const cv::Vec3f& p = surface.points.at<cv::Vec3f>(cell);
+    const cv::Vec3f& p = surface.point(cell);
     centroid += Eigen::Vector3d(p[0], p[1], p[2]);
     box |= cv::Rect(cell, cv::Size(1, 1));
   }
   centroid /= double(surface.cells.size());
   double squared_radius = 0.0;
   for (const cv::Point& cell : surface.cells) {
-    const cv::Vec3f& p = surface.points.at<cv::Vec3f>(cell);
+    const cv::Vec3f& p = surface.point(cell);
     squared_radius += (Eigen::Vector3d(p[0], p[1], p[2]) - centroid).squaredNorm();
   }
   const double rms_radius = std::sqrt(squared_radius / double(surface.cells.size()));
   if (!(rms_radius > 0.0)) return 0.0;
   // Sums of the normals over each cell's window (cells without a point hold zero).
   cv::Mat sums;
-  cv::boxFilter(surface.normals(box), sums, CV_32F, cv::Size(2 * radius + 1, 2 * radius + 1), cv::Point(-1, -1),
+  cv::boxFilter(surface.normals(box - surface.origin), sums, CV_32F, cv::Size(2 * radius + 1, 2 * radius + 1), cv::Point(-1, -1),
                 false, cv::BORDER_CONSTANT);
   Eigen::Matrix<double, 6, 6> information = Eigen::Matrix<double, 6, 6>::Zero();
   for (const cv::Point& cell : surface.cells) {
-    const cv::Vec3f& p = surface.points.at<cv::Vec3f>(cell);
+    const cv::Vec3f& p = surface.point(cell);
     const cv::Vec3f& s = sums.at<cv::Vec3f>(cell - box.tl());
     const Eigen::Vector3d normal = Eigen::Vector3d(s[0], s[1], s[2]).normalized();
     Eigen::Matrix<double, 6, 1> row;

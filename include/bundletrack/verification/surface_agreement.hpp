@@ -45,30 +45,28 @@ class SurfaceAgreement {
       bounds.push_back(settings_.gate.widened(scale).bounds<double>());
     }
     int valid = 0, compared = 0, agreeing = 0;
-    for (int y = 0; y < current.points.rows; ++y) {
-      for (int x = 0; x < current.points.cols; ++x) {
-        const cv::Vec3f& pc = current.points.at<cv::Vec3f>(y, x);
-        if (pc[2] <= 0.0f) continue;
-        ++valid;
-        const Eigen::Vector3d p(pc[0], pc[1], pc[2]);
-        const cv::Vec3f& nc = current.normals.at<cv::Vec3f>(y, x);
-        bool landed = false, agrees = false;
-        for (std::size_t k = 0; k < T_k_c.size() && !agrees; ++k) {
-          const SurfaceGrid& other = graph.nodes[k]->surface;
-          const Eigen::Vector3d q = T_k_c[k] * p;
-          int u = 0, v = 0;
-          if (!other.camera.pixelOf(q, u, v) || !other.inside(u, v)) continue;
-          const cv::Vec3f& pk = other.points.at<cv::Vec3f>(v, u);
-          if (pk[2] <= 0.0f) continue;
-          landed = true;
-          if ((Eigen::Vector3d(pk[0], pk[1], pk[2]) - q).squaredNorm() > bounds[k].max_squared_distance) continue;
-          const cv::Vec3f& nk = other.normals.at<cv::Vec3f>(v, u);
-          const Eigen::Vector3d n = T_k_c[k].rotation() * Eigen::Vector3d(nc[0], nc[1], nc[2]);
-          agrees = n.dot(Eigen::Vector3d(nk[0], nk[1], nk[2])) >= bounds[k].cos_max_angle;
-        }
-        compared += landed;
-        agreeing += agrees;
+    for (const cv::Point& cell : current.cells) {
+      const cv::Vec3f& pc = current.point(cell);
+      if (pc[2] <= 0.0f) continue;
+      ++valid;
+      const Eigen::Vector3d p(pc[0], pc[1], pc[2]);
+      const cv::Vec3f& nc = current.normal(cell);
+      bool landed = false, agrees = false;
+      for (std::size_t k = 0; k < T_k_c.size() && !agrees; ++k) {
+        const SurfaceGrid& other = graph.nodes[k]->surface;
+        const Eigen::Vector3d q = T_k_c[k] * p;
+        int u = 0, v = 0;
+        if (!other.camera.pixelOf(q, u, v) || !other.inside(u, v)) continue;
+        const cv::Vec3f& pk = other.point(u, v);
+        if (pk[2] <= 0.0f) continue;
+        landed = true;
+        if ((Eigen::Vector3d(pk[0], pk[1], pk[2]) - q).squaredNorm() > bounds[k].max_squared_distance) continue;
+        const cv::Vec3f& nk = other.normal(u, v);
+        const Eigen::Vector3d n = T_k_c[k].rotation() * Eigen::Vector3d(nc[0], nc[1], nc[2]);
+        agrees = n.dot(Eigen::Vector3d(nk[0], nk[1], nk[2])) >= bounds[k].cos_max_angle;
       }
+      compared += landed;
+      agreeing += agrees;
     }
     if (compared == 0 || 4 * compared < valid) return 0.0;
     return double(agreeing) / double(compared);
