@@ -65,7 +65,7 @@ struct Energy {
         if (a < 0 || !kept_->reuse(a, b, pose(edges_[e].i), pose(edges_[e].j), systems[e])) fresh.push_back(e);
       }
       std::vector<GraphEdge> edges;
-      std::tuple<std::vector<typename Terms::ResidualType::Input>...> inputs;
+      Inputs inputs;  // of the fresh edges only
       for (const std::size_t e : fresh) {
         edges.push_back(edges_[e]);
         appendInputs(inputs, e, std::index_sequence_for<Terms...>());
