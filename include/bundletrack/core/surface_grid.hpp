@@ -5,6 +5,7 @@
 #include <vector>
 
 #include <opencv2/core.hpp>
+#include <opencv2/imgproc.hpp>
 
 #include "bundletrack/core/camera.hpp"
 #include "bundletrack/core/rgbd_frame.hpp"
@@ -65,7 +66,6 @@ inline SurfaceGrid sampleSurface(const RgbdFrame& frame, const cv::Mat& mask, co
   grid.step = step;
   const cv::Rect region = frame.region.area() > 0 ? frame.region : cv::Rect({0, 0}, frame.points.size());
   const auto firstCell = [step](int pixel) { return (pixel + step - 1) / step; };  // first cell at or after a pixel
-  cv::Rect box;
   for (int y = firstCell(region.y); y < firstCell(region.br().y); ++y) {
     const int v = step * y;
     const auto* points = frame.points.ptr<cv::Vec3f>(v);
@@ -75,11 +75,10 @@ inline SurfaceGrid sampleSurface(const RgbdFrame& frame, const cv::Mat& mask, co
       const int u = step * x;
       if (!on_object[u] || points[u][2] <= 0.0f || normals[u][2] == 0.0f) continue;
       grid.cells.emplace_back(x, y);
-      box = grid.cells.size() == 1 ? cv::Rect(x, y, 1, 1) : box | cv::Rect(x, y, 1, 1);
       if (!frame.color.empty()) grid.colors.push_back(frame.color.at<cv::Vec3b>(v, u));
     }
   }
-  if (box.empty()) box = cv::Rect(0, 0, 1, 1);  // no point: one empty cell
+  const cv::Rect box = grid.cells.empty() ? cv::Rect(0, 0, 1, 1) : cv::boundingRect(grid.cells);  // no point: one empty cell
   grid.origin = box.tl();
   grid.points = cv::Mat::zeros(box.size(), CV_32FC3);
   grid.normals = cv::Mat::zeros(box.size(), CV_32FC3);
