@@ -98,7 +98,7 @@ class Tracker {
     if (!trackBySurface(ctx) && !trackByFollowing(ctx)) {
       detectKeypoints(ctx);
       if (!estimateCoarsePose(ctx)) return lost(ctx);
-      if (!refineCoarsePose(ctx)) return lost(ctx);
+      if (!refineCoarsePose(ctx) && !refineFromFollowing(ctx)) return lost(ctx);
     }
     cutMaskWithFinalPose(ctx);
     admitKeyframe(ctx);
@@ -199,7 +199,8 @@ class Tracker {
   /// optical flow (FollowingSource), RANSAC on those pairs gives the coarse pose (paper IV-B), and
   /// the graph runs as with detected keypoints. Kept when RANSAC keeps follow_min_share of the
   /// keypoints the chain of followed frames began with (and min_inliers) and the verifier accepts the
-  /// graph's pose; otherwise the frame starts over, detecting keypoints, from its search region.
+  /// graph's pose; otherwise the frame starts over, detecting keypoints, from its search region,
+  /// with following's pose in reserve where RANSAC kept min_inliers (estimateCoarsePose).
   bool trackByFollowing(FrameContext& ctx) {
     const KeypointFrame& last = last_->keypoints;
     if (!settings_.follow_keypoints || settings_.keypoints != KeypointSchedule::OnDemand || ctx.recovering ||
@@ -214,12 +215,17 @@ class Tracker {
     });
     const int chain_start = last.chain_start > 0 ? last.chain_start : followed.tried;
     const int needed = std::max(settings_.min_inliers, int(std::ceil(settings_.follow_min_share * chain_start)));
-    if (int(estimate.inliers.size()) < needed) return false;
     CoarseEstimate coarse{estimate.T_second_first * last.T_cam_obj, true, true, Evidence::Features, {}};
     for (const int k : estimate.inliers) coarse.last_inliers.push_back(followed.matches[std::size_t(k)]);
+    if (int(estimate.inliers.size()) < needed) {
+      if (int(estimate.inliers.size()) >= settings_.min_inliers)
+        ctx.followed_reserve.emplace(std::move(followed.features), std::move(coarse));
+      return false;
+    }
     const cv::Mat search_region = ctx.masked.mask;
     ctx.features = std::move(followed.features);
-    if (optimiseFrom(ctx, coarse, nullptr) && acceptPose(ctx) && ctx.result.status == TrackStatus::Tracked) {
+    const bool graph_built = optimiseFrom(ctx, coarse, nullptr);
+    if (graph_built && acceptPose(ctx) && ctx.result.status == TrackStatus::Tracked) {
       ctx.keypoints_followed = true;
       ctx.chain_start = chain_start;
       ctx.result.followed = int(ctx.current.features.size());
@@ -227,6 +233,7 @@ class Tracker {
       ctx.result.inliers = int(estimate.inliers.size());
       return true;
     }
+    if (graph_built) ctx.followed_reserve.emplace(std::move(ctx.current.features), ctx.coarse);  // both cut to its mask
     ctx.masked.mask = search_region;
     ctx.result.mask = cv::Mat();
     ctx.result.status = TrackStatus::Lost;
@@ -252,7 +259,8 @@ class Tracker {
   }
 
   /// Paper IV-B: RANSAC with the last good frame; after lost frames, the candidates of
-  /// reacquisitionCandidates.
+  /// reacquisitionCandidates. Where no pose is found with the last frame, the detected keypoints
+  /// are also kept aside for refineFromFollowing.
   bool estimateCoarsePose(FrameContext& ctx) {
     const KeypointFrame& last = last_->keypoints;
     PairRegistration from_last = registerPair(last.features, ctx.features, std::nullopt);
@@ -261,6 +269,7 @@ class Tracker {
     if (ctx.recovering) return reacquisitionCandidates(ctx, std::move(from_last));
     CoarseEstimate coarse;
     coarse.found = coarse.from_last = ctx.result.inliers >= settings_.min_inliers;
+    if (!coarse.found && ctx.followed_reserve) ctx.detected_kept = ctx.features;
     coarse.T_cam_obj = coarse.found ? from_last.T_second_first * last.T_cam_obj : last_->T_cam_obj;
     if (coarse.found) coarse.last_inliers = std::move(from_last.inliers);
     ctx.candidates.push_back(std::move(coarse));
@@ -497,6 +506,24 @@ class Tracker {
     if (!ctx.coarse.found || ctx.recovering) return false;
     ctx.result.T_cam_obj = ctx.coarse.T_cam_obj;
     ctx.result.status = TrackStatus::CoarseOnly;
+    return true;
+  }
+
+  /// Followed keypoints carry the descriptors of the frame their chain began on, which a turned
+  /// view may no longer match: where the detected keypoints found no pose with the last frame and
+  /// the graph from the last pose was refused, following's pose in reserve (trackByFollowing) is
+  /// tried -- the graph on the followed keypoints, or, refused again, that pose itself as RANSAC's
+  /// between consecutive frames (CoarseOnly). The frame keeps its detected keypoints for later
+  /// (a keyframe's, the next frame's to follow).
+  bool refineFromFollowing(FrameContext& ctx) {
+    if (!ctx.followed_reserve || !ctx.detected_kept) return false;
+    auto& [followed, by_following] = *ctx.followed_reserve;
+    ctx.result.followed = ctx.result.matches = int(followed.size());  // one match per followed keypoint
+    ctx.result.inliers = int(by_following.last_inliers.size());
+    ctx.features = std::move(followed);
+    if (!optimiseFrom(ctx, by_following, nullptr) || !acceptPose(ctx)) return false;
+    ctx.current.features = std::move(*ctx.detected_kept);
+    keepFeaturesInside(ctx.current.features, ctx.masked.mask);
     return true;
   }
 

@@ -1,6 +1,7 @@
 #pragma once
 
 #include <optional>
+#include <utility>
 #include <vector>
 
 #include <opencv2/core.hpp>
@@ -34,6 +35,11 @@ struct FrameContext {
   bool keypoints_detected = false;  ///< on this frame (not always with keypoints on demand)
   bool keypoints_followed = false;  ///< the last good frame's keypoints, followed into this frame (optical flow)
   int chain_start = 0;  ///< then: how many keypoints the chain of followed frames began with
+  /// Following's result where RANSAC kept min_inliers but the frame was not taken on it (short of
+  /// follow_min_share, or its graph refused): the keypoints followed into this frame and the coarse
+  /// pose they give, its inliers indexing them (Tracker::refineFromFollowing).
+  std::optional<std::pair<FrameFeatures, CoarseEstimate>> followed_reserve;
+  std::optional<FrameFeatures> detected_kept;  ///< then: the detected keypoints, where they found no pose with the last frame
   cv::Mat gray;  ///< the frame's grey image, once made (following keypoints reads it, and the next frame follows on it)
   std::vector<CoarseEstimate> candidates;  ///< coarse poses to try, in order (several only after lost frames)
   CoarseEstimate coarse;  ///< the one being tried
