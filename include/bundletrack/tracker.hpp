@@ -200,7 +200,7 @@ class Tracker {
   /// the graph runs as with detected keypoints. Kept when RANSAC keeps follow_min_share of the
   /// keypoints the chain of followed frames began with (and min_inliers) and the verifier accepts the
   /// graph's pose; otherwise the frame starts over, detecting keypoints, from its search region,
-  /// with following's pose in reserve where RANSAC kept min_inliers (estimateCoarsePose).
+  /// with following's pose in reserve where RANSAC kept min_inliers (refineFromFollowing).
   bool trackByFollowing(FrameContext& ctx) {
     const KeypointFrame& last = last_->keypoints;
     if (!settings_.follow_keypoints || settings_.keypoints != KeypointSchedule::OnDemand || ctx.recovering ||
