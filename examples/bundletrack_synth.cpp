@@ -15,7 +15,7 @@ namespace bt = bundletrack;
 
 int main(int argc, char** argv) {
   bt::synth::SyntheticSequenceSettings settings;
-  std::string out, shape = "box", motion = "handheld", sensor = "structured_light", layout_name = "ycbineoat";
+  std::string out, shape = "box", motion = "handheld", sensor = "structured_light", layout_name = "ycbineoat", mask_error = "none";
   std::vector<int> out_of_view;
   bool no_noise = false, labels = false;
   bt::examples::CommandLine command_line(
@@ -64,6 +64,13 @@ int main(int argc, char** argv) {
       ->check(bt::examples::wholeIn(1, 3));
   command_line.add_flag("--labels", labels, "with --objects 2 | 3: one label image per frame, labels/<frame>.png (the k-th\n"
                                             "object labelled k, named in labels/objects.txt), instead of the folders of masks");
+  command_line.add_option("--mask-error", mask_error, "none | dilate | erode | shift: the masks err from the true outline by\n"
+                                                     "--mask-error-px, as a segmentation's do (ground truth unchanged)")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"none", "dilate", "erode", "shift"}));
+  command_line.add_option("--mask-error-px", settings.mask_error_px, "pixels the masks are grown, shrunk or moved right by")
+      ->capture_default_str()
+      ->check(bt::examples::wholeIn(1, 50));
   command_line.add_option("--seed", settings.seed, "random seed of textures and sensor noise")->capture_default_str()->check(bt::examples::wholeAtLeast(0));
   command_line.add_option("--layout", layout_name, "ycbineoat (rgb/%06d.png, depth in mm) | tum (rgb.txt, depth.txt: 30 Hz timestamps,\n"
                                                    "depth 4 ms after colour, in 1/5000 m)")
@@ -77,6 +84,11 @@ int main(int argc, char** argv) {
   if (sensor == "active_stereo") settings.sensor.depth_noise = bt::DepthNoise::activeStereo();
   else if (sensor == "time_of_flight") settings.sensor.depth_noise = bt::DepthNoise::timeOfFlight();
   if (no_noise) settings.sensor = bt::synth::SensorSettings::perfect();
+  const std::map<std::string, bt::synth::MaskError> mask_errors = {{"none", bt::synth::MaskError::None},
+                                                                    {"dilate", bt::synth::MaskError::Dilated},
+                                                                    {"erode", bt::synth::MaskError::Eroded},
+                                                                    {"shift", bt::synth::MaskError::Shifted}};
+  settings.mask_error = mask_errors.at(mask_error);
   if (!out_of_view.empty()) settings.hidden_start = out_of_view[0], settings.hidden_frames = out_of_view[1];
   const bt::io::Layout layout = layout_name == "tum" ? bt::io::Layout::Tum : bt::io::Layout::YcbInEoat;
   const bt::synth::MaskFiles mask_files = labels ? bt::synth::MaskFiles::LabelImages : bt::synth::MaskFiles::Folders;

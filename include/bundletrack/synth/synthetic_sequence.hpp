@@ -11,6 +11,7 @@
 
 #include <Eigen/Geometry>
 #include <opencv2/core.hpp>
+#include <opencv2/imgproc.hpp>
 #include <opencv2/imgcodecs.hpp>
 
 #include "bundletrack/core/error.hpp"
@@ -35,6 +36,15 @@ inline const char* shapeName(Shape shape) {
   }
 }
 
+/// How the written masks err from the objects' true outlines, as a segmentation's masks or a
+/// depth-to-colour registration do (the ground truth is unchanged).
+enum class MaskError {
+  None,
+  Dilated,  ///< grown by mask_error_px: the mask bleeds onto what lies behind the object
+  Eroded,  ///< shrunk by mask_error_px: the mask misses the object's rim
+  Shifted,  ///< moved mask_error_px to the right: both at once, on either side
+};
+
 struct SyntheticSequenceSettings {
   int frames = 300;
   cv::Size image_size{640, 480};
@@ -58,6 +68,8 @@ struct SyntheticSequenceSettings {
   /// each with its own texture and hand-held motion: the second sweeps sideways in front of the
   /// first object, the third behind it, so that they occlude each other. (Hand-held motion only.)
   int objects = 1;
+  MaskError mask_error = MaskError::None;
+  int mask_error_px = 3;  ///< pixels, with a mask_error
   SensorSettings sensor;
   unsigned seed = 1;
   int model_points = 4000;  ///< surface samples written to model/points.xyz
@@ -102,6 +114,8 @@ class SyntheticScene {
       throw InputError("synthetic sequence", "size must be 0 (the shape's own) or up to 5 m");
     if (s_.motion_blur_samples < 1) throw InputError("synthetic sequence", "motion_blur_samples must be >= 1");
     if (s_.objects < 1 || s_.objects > 3) throw InputError("synthetic sequence", "objects must be 1, 2 or 3");
+    if (s_.mask_error != MaskError::None && (s_.mask_error_px < 1 || s_.mask_error_px > 50))
+      throw InputError("synthetic sequence", "mask_error_px must be 1 to 50");
     if (s_.objects > 1 && s_.motion != Motion::HandHeld)
       throw InputError("synthetic sequence", "several objects move only by hand (hand-held motion)");
     for (const Shape shape : {Shape::Box, Shape::Cylinder, Shape::Mug}) {
@@ -188,10 +202,26 @@ class SyntheticScene {
     }
     SyntheticFrame out;
     applySensorModel(clean, s_.camera, s_.sensor, s_.seed * 100003u + unsigned(i), out.depth, out.color);
-    out.mask = clean.label == kObject;
+    out.mask = writtenMask(clean.label == kObject);
     out.T_cam_obj = T_cam_obj(i);
-    for (int k = 1; k < objectCount(); ++k) out.others.push_back({clean.label == objectLabel(k), T_cam_obj(i, k)});
+    for (int k = 1; k < objectCount(); ++k) out.others.push_back({writtenMask(clean.label == objectLabel(k)), T_cam_obj(i, k)});
     return out;
+  }
+
+  /// An object's mask as the sequence gives it: its true visible pixels with the settings' MaskError.
+  cv::Mat writtenMask(const cv::Mat& visible) const {
+    const int px = s_.mask_error_px;
+    const cv::Mat disc = cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(2 * px + 1, 2 * px + 1));
+    cv::Mat mask;
+    switch (s_.mask_error) {
+      case MaskError::Dilated: cv::dilate(visible, mask, disc); return mask;
+      case MaskError::Eroded: cv::erode(visible, mask, disc); return mask;
+      case MaskError::Shifted:
+        mask = cv::Mat::zeros(visible.size(), CV_8UC1);
+        if (px < visible.cols) visible.colRange(0, visible.cols - px).copyTo(mask.colRange(px, visible.cols));
+        return mask;
+      default: return visible;
+    }
   }
 
  private:
