@@ -6,7 +6,7 @@
 # (bundletrack_eval --in-view; they differ where the object leaves the view). With --before, a
 # second build's tracker runs on the very same sequences and its columns stand beside.
 #
-# The design is sparse (41 synthetic cells, not the 144 of the full product), chosen so that each
+# The design is sparse (47 synthetic cells, not the 144 of the full product), chosen so that each
 # factor varies with the others held at their usual value:
 #   A  distance {0.5, 1, 2, 3 m} x object {mug 0.10 m, box 0.20 m, chair 0.70 m} x {textured,
 #      textureless}, structured light, normal speed (no chair at 0.5 m: it would not fit the view);
@@ -14,6 +14,9 @@
 #   C  fast motion (3x) x {box, mug} x {1, 2 m}, textured;
 #   D  an occluder (box, 1 m) and the object carried out of view and back (box at 1 m; textureless
 #      chair at 2.5 m).
+#   E  masks that err from the object's outline by 3 px, as a segmentation's or a depth-to-colour
+#      registration's do (bundletrack_synth --mask-error): grown, shrunk and moved on the box at 1 m,
+#      grown and moved on the textureless box at 3 m, grown on the mug at 1 m.
 #
 # Usage: bash bench/accuracy_matrix.sh BUILD_DIR OUT_DIR [--before BUILD_DIR [--before-label TEXT]]
 #        [--config FILE] [--data DIR] [--frames N] [--markdown FILE]
@@ -69,6 +72,11 @@ done
 cells+=("D_box_1m_occluder|--shape box --distance 1 --occluder")
 cells+=("D_box_1m_out_of_view|--shape box --distance 1 --out-of-view 40 15")
 cells+=("D_chair_2.5m_textureless_out_of_view|--shape chair --size 0.70 --distance 2.5 --textureless --out-of-view 40 15")
+for e in dilate erode shift; do cells+=("E_box_1m_mask_${e}3|--shape box --size 0.20 --distance 1 --mask-error $e --mask-error-px 3"); done
+for e in dilate shift; do
+  cells+=("E_box_3m_textureless_mask_${e}3|--shape box --size 0.20 --distance 3 --textureless --mask-error $e --mask-error-px 3")
+done
+cells+=("E_mug_1m_mask_dilate3|--shape mug --size 0.10 --distance 1 --mask-error dilate --mask-error-px 3")
 
 tool() {  # build name -> path of the build's executable
   if [ -x "$1/bin/$2" ]; then echo "$1/bin/$2"; else echo "$1/$2"; fi
@@ -148,7 +156,8 @@ out = ["# Accuracy stress matrix", "",
        "tracking time per frame on this machine (2 cores); in view: ADD / ADD-S over the frames in which",
        "the object is seen (`bundletrack_eval --in-view`), which differ from the whole sequence's only",
        "where the object leaves the view (D_*_out_of_view). Cell names: A distance x object x texture,",
-       "B sensor, C fast motion, D occlusion and out of view; see the script's header for the design."]
+       "B sensor, C fast motion, D occlusion and out of view, E masks 3 px off the outline; see the",
+       "script's header for the design."]
 if with_before:
     out.append(f"The before columns: {before_label}, on the same sequences.")
 out.append("")

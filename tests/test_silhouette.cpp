@@ -69,6 +69,9 @@ TEST_CASE("the silhouette image is the signed distance to the mask's outline") {
 }
 
 TEST_CASE("the silhouette term counts a point outside the outline only where the frame sees past it") {
+  // Past it: a reading farther than the point by three standard deviations of two readings'
+  // difference. A nearer reading may be an occluder that the mask leaves out, one as near as the
+  // point the object itself where the mask misses it, and without one nothing is known.
   const bt::RgbdFrame frame = rectangleFrame();
   bt::SilhouetteImage t = bt::makeSilhouetteImage(frame, frame.mask, 1, 25);
   t.points.clear();  // one direction only: s's points into t
@@ -83,10 +86,12 @@ TEST_CASE("the silhouette term counts a point outside the outline only where the
   // Three standard deviations of two readings' difference at 1 m (structured light, noise scale 1).
   const double margin = 3.0 * std::sqrt(2.0) * bt::NoiseScale::referenceSpread();
   REQUIRE(margin > 0.005);
-  REQUIRE(margin < 0.035);
+  REQUIRE(margin < 0.015);
   s.points = {at(40, 30, 1.0f),  // inside the outline
               at(53, 30, 1.0f),  // 3.5 px outside, the wall behind it: counts
-              at(40, 12, 1.0f),  // 7.5 px outside, a reading 5 mm nearer: within the noise, counts
+              at(40, 12, 1.0f),  // 7.5 px outside, a reading 5 mm nearer: the object's own surface as far
+                                 // as the noise tells, which the mask misses: does not count
+              at(36, 12, 0.98f),  // 7.5 px outside, a reading 15 mm farther: the frame saw past it, counts
               at(44, 12, 1.03f),  // outside, a reading 35 mm nearer: it may hide the point
               at(40, 50, 1.0f),  // outside, no reading there
               at(64, 30, 1.0f),  // outside, behind the occluder
@@ -94,9 +99,22 @@ TEST_CASE("the silhouette term counts a point outside the outline only where the
   const bt::DenseSilhouette term;
   bt::PairSystem system;
   term.linearise(bt::DenseSilhouette::Input{grid, s, grid, t}, bt::SE3d(), bt::SE3d(), bt::TrivialLoss{}, 1.0, system);
-  CHECK(system.residuals == 2);
+  CHECK(system.residuals == 2);  // (53, 30) and (36, 12)
   // Its weight: (reference spread / sigma)^2 x step / 4 at noise scale 1, step 1 (one camera: a depth
   // error moves the point along t's ray, not across the outline).
   const double weight = std::pow(bt::NoiseScale::referenceSpread() / term.sigma, 2) / 4.0;
   CHECK(system.cost == doctest::Approx(weight * (3.5 * 3.5 + 7.5 * 7.5)));
+}
+
+TEST_CASE("a mask grown onto the background gives the silhouette none of the background's points") {
+  // The rectangle's mask grown by 3 px over the wall 1 m behind it: those pixels lie behind a
+  // depth edge within the mask, farther than the nearest mask reading within 4 px by more than the
+  // noise and a steep surface's rise, and are not the object's.
+  bt::RgbdFrame frame = rectangleFrame();
+  const bt::SilhouetteImage exact = bt::makeSilhouetteImage(frame, frame.mask, 2, 10);
+  cv::dilate(frame.mask, frame.mask, cv::Mat::ones(7, 7, CV_8UC1));
+  const bt::SilhouetteImage grown = bt::makeSilhouetteImage(frame, frame.mask, 2, 10);
+  REQUIRE(grown.box.width > exact.box.width);  // the outline is the grown mask's
+  CHECK(grown.points.size() == exact.points.size());
+  for (const cv::Vec3f& p : grown.points) CHECK(p[2] == 1.0f);
 }

@@ -93,7 +93,7 @@ struct DenseSilhouette {
       // t must see past the point there: without a reading nothing says the object is not there
       // (a depth camera's narrower view, a shadow), with a nearer one an occluder hides it.
       const float seen = t.depthAt(roundToPixel(u), roundToPixel(v));
-      if (seen <= 0.0f || seen < q.z() - occlusion_margin) continue;
+      if (seen <= 0.0f || seen <= q.z() + occlusion_margin) continue;
       const Eigen::Vector3d g = imageGradientAt(q, fx, fy, d_u, d_v);
       // The point's depth error moves it along s's ray, and so across t's outline by g . R_t_s p_s / z_s
       // pixels per metre: the residual's spread beside the outline's own.
