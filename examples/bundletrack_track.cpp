@@ -179,6 +179,15 @@ std::string csvField(const std::string& text) {
 
 /// Makes `out` with its `folders` and checks that files can be written there, before any work:
 /// --out naming a file, a place without permission, a link loop or a name too long is said so.
+/// Whether the sequence, of one object, has a mask for its first frame only: the input the method
+/// starts from ("a mask of the object in the first frame"), which given masks cannot track.
+bool onlyFirstMask(const bt::io::RgbdSequence& sequence) {
+  if (!sequence.objects().empty() || sequence.size() < 2) return false;
+  for (std::size_t i = 1; i < sequence.size(); ++i)
+    if (fs::exists(sequence.maskPath(i))) return false;
+  return true;
+}
+
 void prepareOutput(const fs::path& out, std::vector<fs::path> folders) {
   folders.insert(folders.begin(), ".");
   std::error_code error;
@@ -576,7 +585,8 @@ int main(int argc, char** argv) {
                         "the tracker gets only the first frame's mask and follows the object from it\n"
                         "(masks.source: propagated); later masks, where the sequence has them, are\n"
                         "read only to report each propagated mask's IoU in track.csv and a summary;\n"
-                        "the masks used go to OUT/masks/<frame>.png");
+                        "the masks used go to OUT/masks/<frame>.png; chosen by itself, with a note,\n"
+                        "for a sequence of one object whose masks/ holds the first frame's mask only");
   command_line.add_flag("--viz", options.viz, "write OUT/overlay.mp4 (pose axes, object box, mask outline per frame; an image\n"
                                               "strip OUT/overlay_strip.png always, and in place of the video where no encoder\n"
                                               "is available) and, with ground truth, OUT/errors.png (errors over time)");
@@ -630,6 +640,12 @@ int main(int argc, char** argv) {
     const bt::io::RgbdSequence sequence(options.sequence, config.sequence);
     for (const std::string& caution : sequence.warnings()) std::cerr << "warning: " << caution << '\n';
     const std::vector<std::string> objects = chosenObjects(sequence, options.objects);
+    if (config.masks == "given" && onlyFirstMask(sequence)) {
+      config.masks = "propagated";
+      std::cerr << "note: " << (sequence.root() / "masks").string()
+                << " has a mask for the first frame only: the masks are propagated from it (masks.source: propagated, "
+                   "as --propagate-masks)\n";
+    }
     std::vector<fs::path> folders = {"poses"};
     if (config.masks == "propagated") folders.push_back("masks");
     for (const std::string& object : objects) prepareOutput(options.out / object, folders);

@@ -63,4 +63,13 @@ grep -q "ADD-S" "$work/summary.txt" || fail "no score table for a sequence with 
   fail "bundletrack_track --no-score failed"
 if grep -q "ADD-S" "$work/unscored.txt"; then fail "--no-score still printed the score table"; fi
 [ "$(ls "$work/unscored/poses" | wc -l)" -eq 3 ] || fail "--no-score: not one pose per frame"
+# A sequence with the first frame's mask only (the method's input): the masks are propagated from it,
+# with a note, and every frame is tracked, not lost for want of a mask.
+cp -r "$work/seq" "$work/first_mask" && rm "$work/first_mask/masks/000001.png" "$work/first_mask/masks/000002.png"
+"$track" --sequence "$work/first_mask" --out "$work/first_mask_out" --quiet --no-score > /dev/null 2> "$work/first_mask.txt" ||
+  fail "bundletrack_track on a sequence with only its first mask failed: $(cat "$work/first_mask.txt")"
+grep -q "mask for the first frame only: the masks are propagated" "$work/first_mask.txt" ||
+  fail "no note that the masks are propagated: $(cat "$work/first_mask.txt")"
+[ "$(ls "$work/first_mask_out/masks" | wc -l)" -eq 3 ] || fail "first mask only: the propagated masks are not written"
+if grep -q ",lost," "$work/first_mask_out/track.csv"; then fail "first mask only: frames lost: $(cat "$work/first_mask_out/track.csv")"; fi
 echo "command lines: help, refusals and well-formed runs as expected"
