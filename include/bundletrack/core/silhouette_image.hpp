@@ -19,8 +19,9 @@ namespace bundletrack {
 /// the mask's outline (pixels, positive outside, zero on the outline half a pixel beyond the
 /// outermost mask pixels) and its derivatives along u and v; the frame's depth there, which tells
 /// a point that the object hides from an occluder in front of it; and the frame's own object
-/// points, every `step` pixels of the mask that have depth (with or without a normal: the
-/// outermost ones are what the outline constrains), in the camera frame.
+/// points, every `step` pixels of the mask that have depth and are not behind a depth edge within
+/// it (with or without a normal: the outermost ones are what the outline constrains), in the
+/// camera frame.
 struct SilhouetteImage {
   cv::Mat samples;  ///< CV_32FC3, box.size(): signed distance and its derivatives along u and v
   cv::Mat depth;  ///< CV_32FC1, box.size(): the frame's depth (metres, 0: none)

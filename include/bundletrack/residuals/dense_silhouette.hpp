@@ -13,17 +13,19 @@
 namespace bundletrack {
 
 /// Beyond the paper: every point of the object projects inside the object's silhouette in every
-/// view, seen or hidden (docs/DESIGN.md section 7). A point p_s of frame s (any mask pixel with
-/// depth, every grid step) is the object point a = T_s^-1 p_s; seen from frame t at q = T_t a it
+/// view, seen or hidden (docs/DESIGN.md section 7). A point p_s of frame s (a mask pixel with
+/// depth, every grid step, that is the object's: makeSilhouetteImage) is the object point
+/// a = T_s^-1 p_s; seen from frame t at q = T_t a it
 /// should not land outside t's mask:
 ///   r = max(0, D_t(pi(q))),
 /// D_t the signed distance to t's outline in pixels (positive outside), with the Jacobian of an
 /// image residual (imageResidualJacobian) where r > 0, and dr/dd_s = -dr/dd_t. It counts only
-/// where t sees past the point: where t's reading is nearer by more than three standard
-/// deviations of two readings' difference, an occluder that the mask leaves out may hide it (a
-/// hand, a support it stands on or in); without a reading nothing says the object is not there
-/// (a depth camera's narrower view, a shadow); nor does a point that lands outside t's silhouette
-/// image count. Both directions of an edge are summed. The masks must be
+/// where t saw past the point: t's reading there farther than it by more than three standard
+/// deviations of two readings' difference. A nearer reading may be an occluder that the mask
+/// leaves out (a hand, a support it stands on or in), one within the noise of the point the
+/// object itself where t's mask misses it (a segmentation's rim, a mask moved by the depth-to-colour
+/// registration); without a reading nothing says the object is not there (a depth camera's
+/// narrower view, a shadow); nor does a point that lands outside t's silhouette image count. Both directions of an edge are summed. The masks must be
 /// the object's outline from the data (GivenMasks::kOutlinesObject): the tracker makes no
 /// silhouettes from masks it propagates itself.
 /// What it holds: the outline pins the motion that the surface lets slide -- a box seen on two
@@ -90,8 +92,8 @@ struct DenseSilhouette {
       const double u = fx * q.x() / q.z() + cx, v = fy * q.y() / q.z() + cy;
       double distance = 0.0, d_u = 0.0, d_v = 0.0;
       if (t.deepInside(u, v) || !t.sample(u, v, distance, d_u, d_v) || distance <= 0.0) continue;
-      // t must see past the point there: without a reading nothing says the object is not there
-      // (a depth camera's narrower view, a shadow), with a nearer one an occluder hides it.
+      // t must have seen past the point there: without a reading nothing says the object is not
+      // there, a nearer one may be an occluder, one as near the object where t's mask misses it.
       const float seen = t.depthAt(roundToPixel(u), roundToPixel(v));
       if (seen <= 0.0f || seen <= q.z() + occlusion_margin) continue;
       const Eigen::Vector3d g = imageGradientAt(q, fx, fy, d_u, d_v);
