@@ -219,7 +219,7 @@ class Tracker {
     for (const int k : estimate.inliers) coarse.last_inliers.push_back(followed.matches[std::size_t(k)]);
     if (int(estimate.inliers.size()) < needed) {
       if (int(estimate.inliers.size()) >= settings_.min_inliers)
-        ctx.followed_reserve.emplace(std::move(followed.features), std::move(coarse));
+        ctx.followed_reserve = FollowedReserve{std::move(followed.features), std::move(coarse)};
       return false;
     }
     const cv::Mat search_region = ctx.masked.mask;
@@ -233,7 +233,7 @@ class Tracker {
       ctx.result.inliers = int(estimate.inliers.size());
       return true;
     }
-    if (graph_built) ctx.followed_reserve.emplace(std::move(ctx.current.features), ctx.coarse);  // both cut to its mask
+    if (graph_built) ctx.followed_reserve = FollowedReserve{std::move(ctx.current.features), ctx.coarse};  // both cut to its mask
     ctx.masked.mask = search_region;
     ctx.result.mask = cv::Mat();
     ctx.result.status = TrackStatus::Lost;
@@ -517,11 +517,11 @@ class Tracker {
   /// (a keyframe's, the next frame's to follow).
   bool refineFromFollowing(FrameContext& ctx) {
     if (!ctx.followed_reserve || !ctx.detected_kept) return false;
-    auto& [followed, by_following] = *ctx.followed_reserve;
-    ctx.result.followed = ctx.result.matches = int(followed.size());  // one match per followed keypoint
-    ctx.result.inliers = int(by_following.last_inliers.size());
-    ctx.features = std::move(followed);
-    if (!optimiseFrom(ctx, by_following, nullptr) || !acceptPose(ctx)) return false;
+    FollowedReserve& reserve = *ctx.followed_reserve;
+    ctx.result.followed = ctx.result.matches = int(reserve.keypoints.size());  // one match per followed keypoint
+    ctx.result.inliers = int(reserve.coarse.last_inliers.size());
+    ctx.features = std::move(reserve.keypoints);
+    if (!optimiseFrom(ctx, reserve.coarse, nullptr) || !acceptPose(ctx)) return false;
     ctx.current.features = std::move(*ctx.detected_kept);
     keepFeaturesInside(ctx.current.features, ctx.masked.mask);
     return true;

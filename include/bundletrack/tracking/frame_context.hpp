@@ -1,7 +1,6 @@
 #pragma once
 
 #include <optional>
-#include <utility>
 #include <vector>
 
 #include <opencv2/core.hpp>
@@ -22,6 +21,13 @@ struct CoarseEstimate {
   std::vector<FeatureMatch> last_inliers;  ///< the matches with the last good frame that RANSAC kept
 };
 
+/// Following's result where RANSAC kept min_inliers but the frame was not taken on it (short of
+/// follow_min_share, or its graph refused): kept for Tracker::refineFromFollowing.
+struct FollowedReserve {
+  FrameFeatures keypoints;  ///< the last good frame's keypoints, followed into this frame
+  CoarseEstimate coarse;  ///< the pose RANSAC gives on them, its inliers indexing `keypoints`
+};
+
 /// Everything the pipeline's stages know about one frame, in the order they learn it.
 struct FrameContext {
   FrameContext(const RgbdFrame& frame_, int id_, bool recovering_)
@@ -35,10 +41,7 @@ struct FrameContext {
   bool keypoints_detected = false;  ///< on this frame (not always with keypoints on demand)
   bool keypoints_followed = false;  ///< the last good frame's keypoints, followed into this frame (optical flow)
   int chain_start = 0;  ///< then: how many keypoints the chain of followed frames began with
-  /// Following's result where RANSAC kept min_inliers but the frame was not taken on it (short of
-  /// follow_min_share, or its graph refused): the keypoints followed into this frame and the coarse
-  /// pose they give, its inliers indexing them (Tracker::refineFromFollowing).
-  std::optional<std::pair<FrameFeatures, CoarseEstimate>> followed_reserve;
+  std::optional<FollowedReserve> followed_reserve;
   std::optional<FrameFeatures> detected_kept;  ///< then: the detected keypoints, where they found no pose with the last frame
   cv::Mat gray;  ///< the frame's grey image, once made (following keypoints reads it, and the next frame follows on it)
   std::vector<CoarseEstimate> candidates;  ///< coarse poses to try, in order (several only after lost frames)
