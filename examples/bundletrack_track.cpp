@@ -177,17 +177,21 @@ std::string csvField(const std::string& text) {
   return quoted + "\"";
 }
 
-/// Makes `out` with its `folders` and checks that files can be written there, before any work:
-/// --out naming a file, a place without permission, a link loop or a name too long is said so.
-/// Whether the sequence, of one object, has a mask for its first frame only: the input the method
-/// starts from ("a mask of the object in the first frame"), which given masks cannot track.
-bool onlyFirstMask(const bt::io::RgbdSequence& sequence) {
-  if (!sequence.objects().empty() || sequence.size() < 2) return false;
-  for (std::size_t i = 1; i < sequence.size(); ++i)
-    if (fs::exists(sequence.maskPath(i))) return false;
+/// Whether every object to track has a mask for one frame only: the input the method starts from
+/// ("a mask of the object in the first frame"), past which given masks cannot track. A sequence of
+/// label images counts its label images (one holds every object's mask of that frame).
+bool oneMaskEach(const bt::io::RgbdSequence& sequence, const std::vector<std::string>& objects) {
+  if (sequence.size() < 2) return false;
+  for (const std::string& object : objects) {
+    int masks = 0;
+    for (std::size_t i = 0; i < sequence.size() && masks < 2; ++i) masks += fs::exists(sequence.maskPath(i, object));
+    if (masks != 1) return false;
+  }
   return true;
 }
 
+/// Makes `out` with its `folders` and checks that files can be written there, before any work:
+/// --out naming a file, a place without permission, a link loop or a name too long is said so.
 void prepareOutput(const fs::path& out, std::vector<fs::path> folders) {
   folders.insert(folders.begin(), ".");
   std::error_code error;
@@ -640,11 +644,12 @@ int main(int argc, char** argv) {
     const bt::io::RgbdSequence sequence(options.sequence, config.sequence);
     for (const std::string& caution : sequence.warnings()) std::cerr << "warning: " << caution << '\n';
     const std::vector<std::string> objects = chosenObjects(sequence, options.objects);
-    if (config.masks == "given" && onlyFirstMask(sequence)) {
+    if (config.masks == "given" && oneMaskEach(sequence, objects)) {
       config.masks = "propagated";
-      std::cerr << "note: " << (sequence.root() / "masks").string()
-                << " has a mask for the first frame only: the masks are propagated from it (masks.source: propagated, "
-                   "as --propagate-masks)\n";
+      std::cerr << "note: " << sequence.objectList().string()
+                << (sequence.objects().empty() ? " has a mask for the first frame only"
+                                               : ": each object has a mask for one frame only")
+                << ": the masks are propagated from it (masks.source: propagated, as --propagate-masks)\n";
     }
     std::vector<fs::path> folders = {"poses"};
     if (config.masks == "propagated") folders.push_back("masks");

@@ -3,7 +3,8 @@
 # outputs in OUT/<object>/, a score row per object, --objects choosing one of them (whose poses
 # are those of the run with both), unknown names and --objects on a one-object sequence refused
 # with the reason; a missing mask of one object loses only that object's frame. The same sequence
-# with label images instead of mask folders gives the same poses.
+# with label images instead of mask folders gives the same poses. With each object's first mask
+# alone, the masks are propagated.
 # Usage: multi_objects.sh BUNDLETRACK_SYNTH BUNDLETRACK_TRACK WORK_DIR
 set -euo pipefail
 synth=$1 track=$2 work=$3
@@ -46,6 +47,22 @@ if "$track" --sequence "$work/two_labels" --out "$work/z" --objects plate 2> "$w
 fi
 grep -q "no object 'plate' in .*labels/objects.txt (it has box, cylinder)" "$work/unknown_label.txt" \
   || fail "unknown label: $(head -1 "$work/unknown_label.txt")"
+# Each object's first mask only (the method's input), in mask folders or one label image: the masks
+# are propagated from them, with a note, and no frame is lost for want of a mask.
+cp -r "$work/two" "$work/two_first" && cp -r "$work/two_labels" "$work/labels_first"
+find "$work/two_first/masks" "$work/labels_first/labels" -name '*.png' ! -name 000000.png -delete
+for first in two_first labels_first; do
+  "$track" --sequence "$work/$first" --out "$work/${first}_out" --quiet --no-score > /dev/null 2> "$work/$first.txt" ||
+    fail "$first: exit status $?: $(cat "$work/$first.txt")"
+  grep -q "each object has a mask for one frame only: the masks are propagated" "$work/$first.txt" ||
+    fail "$first: no note that the masks are propagated: $(cat "$work/$first.txt")"
+  for object in box cylinder; do
+    [ "$(ls "$work/${first}_out/$object/masks" | wc -l)" -eq 8 ] || fail "$first: $object's propagated masks not written"
+    if grep -q ",lost," "$work/${first}_out/$object/track.csv"; then
+      fail "$first: $object's frames lost: $(grep ",lost," "$work/${first}_out/$object/track.csv")"
+    fi
+  done
+done
 if "$synth" --out "$work/w" --labels 2> "$work/labels_one.txt" > /dev/null; then fail "--labels with one object was accepted"; fi
 grep -q -- "--labels needs --objects 2 or 3" "$work/labels_one.txt" || fail "--labels alone: $(cat "$work/labels_one.txt")"
 echo "multi-object command line: ok"
