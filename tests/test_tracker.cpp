@@ -627,6 +627,38 @@ TEST_CASE("makeTracker applies the settings it is given and the coarse tracker i
   CHECK(largestDifference(track(*bt::makeTracker(tight, short_scene.camera()), scene, model), composed) > 1e-6);
 }
 
+TEST_CASE("a first frame without depth under its mask or with a pose its depth contradicts is refused, naming the likely depth unit") {
+  const ShortScene short_scene(1);
+  const synth::SyntheticFrame f = short_scene.scene.frame(0);
+  const auto initialize = [&](double depth_factor, const bt::SE3d& T_cam_obj) {
+    const bt::RgbdFrame frame = bt::makeFrame("000000", f.color, f.depth * depth_factor, f.mask, short_scene.camera());
+    bt::DefaultTracker(short_scene.camera()).initialize(frame, T_cam_obj);
+    bt::DefaultCoarseTracker().initialize(frame, T_cam_obj);
+  };
+  const auto message = [&](double depth_factor, const bt::SE3d& T_cam_obj) -> std::string {
+    try {
+      initialize(depth_factor, T_cam_obj);
+    } catch (const bt::InputError& error) {
+      return error.what();
+    }
+    return "accepted";
+  };
+  CHECK_NOTHROW(initialize(1.0, f.T_cam_obj));  // the box's centre 0.73 m away, its near face ~0.1 m nearer
+  CHECK_NOTHROW(initialize(5.0, bt::SE3d()));  // no pose known: nothing to compare
+  // Depth in 0.2 mm units read as millimetres (x5), 0.1 mm (x10), and the inverse mistakes.
+  CHECK(message(5.0, f.T_cam_obj).find("000000: the start pose puts the object's origin at depth 0.7") != std::string::npos);
+  CHECK(message(5.0, f.T_cam_obj).find("the depth reads 5 times too far: depth.scale is probably 5 times too large") != std::string::npos);
+  CHECK(message(10.0, f.T_cam_obj).find("10 times too far") != std::string::npos);
+  CHECK(message(0.2, f.T_cam_obj).find("5 times too near: depth.scale is probably 5 times too small") != std::string::npos);
+  CHECK(message(3.0, f.T_cam_obj).find("the depth scale is probably wrong") != std::string::npos);
+  // Depth in 0.01 mm units read as 0.1 mm: the box 7 cm away, nearer than depth.min_depth.
+  CHECK(message(0.1, f.T_cam_obj).find("no depth reading under the object's mask") != std::string::npos);
+  CHECK(message(0.1, bt::SE3d()).find("no depth reading under the object's mask") != std::string::npos);
+  // An origin behind the camera.
+  const bt::SE3d behind(f.T_cam_obj.rotation(), -f.T_cam_obj.translation());
+  CHECK(message(1.0, behind).find("behind the camera (T_cam_obj maps object points into the camera frame") != std::string::npos);
+}
+
 TEST_CASE("makeTracker refuses combinations that do not exist, naming the keys") {
   const bt::PinholeCameraf camera{600.0f, 600.0f, 319.5f, 239.5f};
   const auto problem = [&](const bt::Config& config) -> std::string {

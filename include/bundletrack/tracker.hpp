@@ -11,6 +11,7 @@
 #include "bundletrack/core/angles.hpp"
 #include "bundletrack/core/error.hpp"
 #include "bundletrack/core/image_region.hpp"
+#include "bundletrack/core/start_frame_check.hpp"
 #include "bundletrack/energy.hpp"
 #include "bundletrack/features/correspondence_source.hpp"
 #include "bundletrack/graph/keyframe_pool.hpp"
@@ -62,7 +63,10 @@ class Tracker {
   }
 
   /// Starts the track: the first frame with its mask and pose is keyframe 0, the graph's fixed node.
+  /// A frame without depth under its mask, or a pose its depth contradicts, is refused
+  /// (checkStartFrame).
   TrackResult initialize(const RgbdFrame& frame, const SE3d& T_cam_obj = {}) {
+    checkStartFrame(frame.depth, frame.mask, T_cam_obj, frame.name);
     clock_.start(&StageTimings::mask);
     TrackResult result;
     RgbdFrame masked = frame;  // shares the image buffers

@@ -8,7 +8,8 @@
 # as failures from the run's track.csv as bundletrack_track does, and with --in-view only the
 # frames whose mask is not empty. A run that tracks nothing
 # after the first frame prints no frame rate. An --out that cannot take the results (a file, a link
-# loop, a name too long) and a directory where cam_K.txt belongs are refused, naming the cause. A
+# loop, a name too long) and a directory where cam_K.txt belongs are refused, naming the cause, as is
+# depth in other units than the scale says where the first pose tells (5 times too far). A
 # run that stops leaves OUT/INCOMPLETE with the error; a finished one none.
 # Usage: bad_frames.sh BUNDLETRACK_SYNTH BUNDLETRACK_TRACK BUNDLETRACK_EVAL WORK_DIR
 set -euo pipefail
@@ -107,7 +108,12 @@ ln -s "$work/loop_b" "$work/loop_a" && ln -s "$work/loop_a" "$work/loop_b"
 expect_error "--out cannot be used: Too many levels of symbolic links" --sequence "$work/gone" --out "$work/loop_a"
 long=$(printf 'x%.0s' $(seq 300))
 expect_error "File name too long" --sequence "$work/gone" --out "$work/$long"
+# Depth read 5 times too far (0.2 mm units taken for millimetres): a box 0.4 m away seems 1.8 m
+# away, within any sensor's range, but its annotated first pose says 0.4 m: refused, naming the unit.
+"$synth" --out "$work/near" --frames 2 --distance 0.4 > /dev/null
+expect_error "000000: the start pose puts the object's origin at depth 0.400 m, the depth under its mask 1.79. m (4.4. times as far): the depth reads 5 times too far: depth.scale is probably 5 times too large" \
+  --sequence "$work/near" --out "$work/near_out" --depth-scale 0.005
 # A directory where a file belongs.
 rm "$work/gone/cam_K.txt" && mkdir "$work/gone/cam_K.txt"
 expect_error "cam_K.txt: is a directory, expected a file" --sequence "$work/gone" --out "$work/dir_k"
-echo "bad frames: lost with their reasons, run completed; --strict stops at the first; an empty model stops it first; unusable --out refused first"
+echo "bad frames: lost with their reasons, run completed; --strict stops at the first; an empty model stops it first; unusable --out and depth in other units refused first"

@@ -4,6 +4,7 @@
 
 #include "bundletrack/core/error.hpp"
 #include "bundletrack/core/image_region.hpp"
+#include "bundletrack/core/start_frame_check.hpp"
 #include "bundletrack/features/correspondence_source.hpp"
 #include "bundletrack/registration/feature_registration.hpp"
 #include "bundletrack/tracking/stage_clock.hpp"
@@ -28,10 +29,13 @@ class CoarseTracker {
                          Settings settings = Settings())
       : correspondences_(std::move(correspondences)), registration_(std::move(registration)), settings_(settings) {}
 
-  /// Starts a track at frame 0 with its known pose (identity makes the first camera the object frame).
+  /// Starts a track at frame 0 with its known pose (identity makes the first camera the object frame;
+  /// a frame without depth under the mask or a pose its depth contradicts is
+  /// refused: checkStartFrame).
   TrackResult initialize(const RgbdFrame& frame, const SE3d& T_cam_obj = {}) {
     if (frame.mask.empty() || cv::countNonZero(frame.mask) == 0)
       throw InputError("frame " + frame.name, "the first frame needs a non-empty object mask");
+    checkStartFrame(frame.depth, frame.mask, T_cam_obj, frame.name);
     clock_.start(&StageTimings::features);
     reference_ = correspondences_.detect(frame);
     T_cam_obj_ = T_cam_obj;
