@@ -590,7 +590,8 @@ int main(int argc, char** argv) {
                         "(masks.source: propagated); later masks, where the sequence has them, are\n"
                         "read only to report each propagated mask's IoU in track.csv and a summary;\n"
                         "the masks used go to OUT/masks/<frame>.png; chosen by itself, with a note,\n"
-                        "for a sequence of one object whose masks/ holds the first frame's mask only");
+                        "where every object has a mask for one frame only (masks/ with the first frame's\n"
+                        "mask alone; of several objects, one mask of each)");
   command_line.add_flag("--viz", options.viz, "write OUT/overlay.mp4 (pose axes, object box, mask outline per frame; an image\n"
                                               "strip OUT/overlay_strip.png always, and in place of the video where no encoder\n"
                                               "is available) and, with ground truth, OUT/errors.png (errors over time)");
