@@ -201,8 +201,9 @@ void prepareOutput(const fs::path& out, std::vector<fs::path> folders) {
   if (fs::exists(status) && !fs::is_directory(status))
     throw bt::InputError(out, "--out names a file, not a directory (the poses, track.csv and plots go into it)");
   for (const fs::path& folder : folders) {
-    fs::create_directories(out / folder, error);
-    if (error) throw bt::InputError(out / folder, "--out: cannot create the directory: " + error.message());
+    const fs::path directory = folder == "." ? out : out / folder;
+    fs::create_directories(directory, error);
+    if (error) throw bt::InputError(directory, "--out: cannot create the directory: " + error.message());
   }
   const fs::path probe = out / ".write_test";
   if (!std::ofstream(probe)) throw bt::InputError(out, std::string("--out is not writable: ") + std::strerror(errno));

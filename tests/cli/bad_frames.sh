@@ -8,7 +8,7 @@
 # as failures from the run's track.csv as bundletrack_track does, and with --in-view only the
 # frames whose mask is not empty. A run that tracks nothing
 # after the first frame prints no frame rate. An --out that cannot take the results (a file, a link
-# loop, a name too long) and a directory where cam_K.txt belongs are refused, naming the cause, as is
+# loop, a place where no directory can be made, a name too long) and a directory where cam_K.txt belongs are refused, naming the cause, as is
 # depth in other units than the scale says where the first pose tells (5 times too far). A
 # run that stops leaves OUT/INCOMPLETE with the error; a finished one none.
 # Usage: bad_frames.sh BUNDLETRACK_SYNTH BUNDLETRACK_TRACK BUNDLETRACK_EVAL WORK_DIR
@@ -106,6 +106,7 @@ cp "$work/out/track.csv" "$work/a_file"
 expect_error "a_file: --out names a file, not a directory" --sequence "$work/gone" --out "$work/a_file"
 ln -s "$work/loop_b" "$work/loop_a" && ln -s "$work/loop_a" "$work/loop_b"
 expect_error "--out cannot be used: Too many levels of symbolic links" --sequence "$work/gone" --out "$work/loop_a"
+expect_error "^error: /proc/bundletrack_out: --out: cannot create the directory" --sequence "$work/gone" --out /proc/bundletrack_out
 long=$(printf 'x%.0s' $(seq 300))
 expect_error "File name too long" --sequence "$work/gone" --out "$work/$long"
 # Depth read 5 times too far (0.2 mm units taken for millimetres): a box 0.4 m away seems 1.8 m
