@@ -100,8 +100,9 @@ inline cv::Mat depthFromImage(const cv::Mat& raw, double scale, const std::files
 /// away. A frame median beyond max_range itself but within twice it is returned as a caution (the
 /// caller shows it; empty: none): 0.2 mm units read as millimetres put a scene whose median is
 /// 0.8-1.6 m there, and the sensor's noise is unspecified there anyway. Scenes nearer than that
-/// read five times too far cannot be told from real far ones. `scale` is the unit the depth was
-/// read with, `source` names the depth in the messages.
+/// read five times too far cannot be told from real far ones by ranges (a start pose can tell:
+/// checkStartFrame). `scale` is the unit the depth was read with, `source` names the depth in the
+/// messages.
 [[nodiscard]] inline std::string checkDepthScale(const cv::Mat& depth, const cv::Mat& mask, double scale,
                                                  const std::filesystem::path& source, double max_range = 0.0) {
   const auto median = [&](bool whole_frame) {
