@@ -627,7 +627,7 @@ TEST_CASE("makeTracker applies the settings it is given and the coarse tracker i
   CHECK(largestDifference(track(*bt::makeTracker(tight, short_scene.camera()), scene, model), composed) > 1e-6);
 }
 
-TEST_CASE("a first frame without depth under its mask or with a pose its depth contradicts is refused, naming the likely depth unit") {
+TEST_CASE("a first frame without depth under its mask or with a pose its depth contradicts is refused, naming the likely depth unit or the pose's mistake") {
   const ShortScene short_scene(1);
   const synth::SyntheticFrame f = short_scene.scene.frame(0);
   const auto initialize = [&](double depth_factor, const bt::SE3d& T_cam_obj) {
@@ -654,9 +654,15 @@ TEST_CASE("a first frame without depth under its mask or with a pose its depth c
   // Depth in 0.01 mm units read as 0.1 mm: the box 7 cm away, nearer than depth.min_depth.
   CHECK(message(0.1, f.T_cam_obj).find("no depth reading under the object's mask") != std::string::npos);
   CHECK(message(0.1, bt::SE3d()).find("no depth reading under the object's mask") != std::string::npos);
-  // An origin behind the camera.
+  // An origin behind the camera, and one beside the object: 0.3 m sideways the box's origin lies
+  // 18.6 degrees beside its mask, which spans 13.1 degrees; 5 cm sideways it still passes.
   const bt::SE3d behind(f.T_cam_obj.rotation(), -f.T_cam_obj.translation());
   CHECK(message(1.0, behind).find("behind the camera (T_cam_obj maps object points into the camera frame") != std::string::npos);
+  const auto beside = [&](double metres) {
+    return bt::SE3d(f.T_cam_obj.rotation(), f.T_cam_obj.translation() + Eigen::Vector3d(metres, 0.0, 0.0));
+  };
+  CHECK(message(1.0, beside(0.3)).find("degrees beside the object's mask, which spans") != std::string::npos);
+  CHECK(message(1.0, beside(0.05)) == "accepted");
 }
 
 TEST_CASE("makeTracker refuses combinations that do not exist, naming the keys") {

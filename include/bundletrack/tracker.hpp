@@ -66,7 +66,7 @@ class Tracker {
   /// A frame without depth under its mask, or a pose its depth contradicts, is refused
   /// (checkStartFrame).
   TrackResult initialize(const RgbdFrame& frame, const SE3d& T_cam_obj = {}) {
-    checkStartFrame(frame.depth, frame.mask, T_cam_obj, frame.name);
+    checkStartFrame(frame, T_cam_obj);
     clock_.start(&StageTimings::mask);
     TrackResult result;
     RgbdFrame masked = frame;  // shares the image buffers

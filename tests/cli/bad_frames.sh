@@ -8,9 +8,10 @@
 # as failures from the run's track.csv as bundletrack_track does, and with --in-view only the
 # frames whose mask is not empty. A run that tracks nothing
 # after the first frame prints no frame rate. An --out that cannot take the results (a file, a link
-# loop, a place where no directory can be made, a name too long) and a directory where cam_K.txt belongs are refused, naming the cause, as is
-# depth in other units than the scale says where the first pose tells (5 times too far). A
-# run that stops leaves OUT/INCOMPLETE with the error; a finished one none.
+# loop, a place where no directory can be made, a name too long) and a directory where cam_K.txt
+# belongs are refused, naming the cause, as are depth in other units than the scale says where the
+# first pose tells (5 times too far) and a first pose beside the object. A run that stops leaves
+# OUT/INCOMPLETE with the error; a finished one none.
 # Usage: bad_frames.sh BUNDLETRACK_SYNTH BUNDLETRACK_TRACK BUNDLETRACK_EVAL WORK_DIR
 set -euo pipefail
 synth=$1 track=$2 eval=$3 work=$4
@@ -114,6 +115,10 @@ expect_error "File name too long" --sequence "$work/gone" --out "$work/$long"
 "$synth" --out "$work/near" --frames 2 --distance 0.4 > /dev/null
 expect_error "000000: the start pose puts the object's origin at depth 0.400 m, the depth under its mask 1.79. m (4.4. times as far): the depth reads 5 times too far: depth.scale is probably 5 times too large" \
   --sequence "$work/near" --out "$work/near_out" --depth-scale 0.005
+# A first pose 0.5 m beside the object (another frame's, or inverted): refused, not tracked from.
+cp -r "$work/near" "$work/beside" && printf "1 0 0 0.5\n0 1 0 0\n0 0 1 0.4\n0 0 0 1\n" > "$work/beside/annotated_poses/000000.txt"
+expect_error "000000: the start pose puts the object's origin .* degrees beside the object's mask" \
+  --sequence "$work/beside" --out "$work/beside_out"
 # A directory where a file belongs.
 rm "$work/gone/cam_K.txt" && mkdir "$work/gone/cam_K.txt"
 expect_error "cam_K.txt: is a directory, expected a file" --sequence "$work/gone" --out "$work/dir_k"

@@ -35,7 +35,7 @@ class CoarseTracker {
   TrackResult initialize(const RgbdFrame& frame, const SE3d& T_cam_obj = {}) {
     if (frame.mask.empty() || cv::countNonZero(frame.mask) == 0)
       throw InputError("frame " + frame.name, "the first frame needs a non-empty object mask");
-    checkStartFrame(frame.depth, frame.mask, T_cam_obj, frame.name);
+    checkStartFrame(frame, T_cam_obj);
     clock_.start(&StageTimings::features);
     reference_ = correspondences_.detect(frame);
     T_cam_obj_ = T_cam_obj;
