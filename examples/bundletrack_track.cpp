@@ -26,6 +26,7 @@
 
 #include "bundletrack/config/config_file.hpp"
 #include "bundletrack/core/frame_memory.hpp"
+#include "bundletrack/core/start_frame_check.hpp"
 #include "bundletrack/eval/mask_iou.hpp"
 #include "bundletrack/eval/pose_metrics.hpp"
 #include "bundletrack/eval/score_table.hpp"
@@ -457,10 +458,23 @@ void run(bt::MultiObjectTracker& tracker, const bt::io::RgbdSequence& sequence, 
     if (frame) {
       // An object starts at its annotated pose in that frame where it has ground truth (its first
       // frame stays strict), else at the identity.
+      // A start pose that the frame contradicts (checkStartFrame) keeps the object from starting
+      // there, with the reason, unless it is the only object's first frame or --strict.
       std::vector<bt::SE3d> start(count);
-      for (std::size_t k = 0; k < count; ++k)
-        if (!tracker.started(k) && given[k] && cv::countNonZero(*given[k]) > 0 && sequence.hasGroundTruth(objects[k]))
-          start[k] = sequence.groundTruthPose(i, objects[k]);
+      for (std::size_t k = 0; k < count; ++k) {
+        if (tracker.started(k) || !given[k] || cv::countNonZero(*given[k]) == 0 || !sequence.hasGroundTruth(objects[k]))
+          continue;
+        start[k] = sequence.groundTruthPose(i, objects[k]);
+        bt::RgbdFrame own = *frame;
+        own.mask = *given[k];
+        try {
+          bt::checkStartFrame(own, start[k]);
+        } catch (const bt::InputError& error) {
+          if (options.strict || (i == 0 && !several)) throw;
+          problems[k] = error.what();
+          given[k] = std::nullopt;
+        }
+      }
       results = tracker.track(*frame, given, start);
     }
     const double track_ms = tracking.lap();
@@ -472,9 +486,9 @@ void run(bt::MultiObjectTracker& tracker, const bt::io::RgbdSequence& sequence, 
     for (std::size_t k = 0; k < count; ++k) {
       const std::string& problem = frame ? problems[k] : frame_problem;
       const bool started = tracker.started(k);
-      if (started && !results[k] && !options.quiet)
-        std::fprintf(stderr, "%sframe %s%s lost: %s\n", interactive ? "\n" : "", sequence.frameNames()[i].c_str(),
-                     several ? (" " + objects[k]).c_str() : "", problem.c_str());
+      if (!results[k] && (started || !problem.empty()) && !options.quiet)
+        std::fprintf(stderr, "%sframe %s%s %s: %s\n", interactive ? "\n" : "", sequence.frameNames()[i].c_str(),
+                     several ? (" " + objects[k]).c_str() : "", started ? "lost" : "not started", problem.c_str());
       const std::optional<bt::TrackResult> recorded =
           outputs[k]->record(i, std::move(results[k]), started, problem, read_ms, dataset_masks[k]);
       if (recorded) {
@@ -599,7 +613,9 @@ int main(int argc, char** argv) {
   command_line.add_flag("--strict", options.strict, "a later frame that cannot be read (file missing or undecodable, depth without\n"
                                                     "a reading, no mask with given masks, no annotated pose) stops the run; by\n"
                                                     "default it is reported lost with the reason (track.csv: problem) and the run\n"
-                                                    "goes on, the frame scored as a failure (without an annotated pose: not scored)");
+                                                    "goes on, the frame scored as a failure (without an annotated pose: not scored);\n"
+                                                    "likewise an object's start pose that its frame contradicts (checkStartFrame),\n"
+                                                    "which by default keeps that object from starting there");
   command_line.add_option("--objects", options.objects, "a sequence of several objects (masks/<object>/<frame>.png, one folder per\n"
                                                         "object, or label images labels/<frame>.png named by labels/objects.txt;\n"
                                                         "annotated_poses/<object>/ and model/<object>/ likewise): the objects\n"

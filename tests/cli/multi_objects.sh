@@ -4,7 +4,7 @@
 # are those of the run with both), unknown names and --objects on a one-object sequence refused
 # with the reason; a missing mask of one object loses only that object's frame. The same sequence
 # with label images instead of mask folders gives the same poses. With each object's first mask
-# alone, the masks are propagated.
+# alone, the masks are propagated. A start pose beside an object delays that object's start.
 # Usage: multi_objects.sh BUNDLETRACK_SYNTH BUNDLETRACK_TRACK WORK_DIR
 set -euo pipefail
 synth=$1 track=$2 work=$3
@@ -63,6 +63,19 @@ for first in two_first labels_first; do
     fi
   done
 done
+# A start pose that the frame contradicts (here 0.5 m beside the cylinder) keeps that object from
+# starting there, with the reason; it starts on the next frame, the other object is not touched.
+# With --strict the run stops.
+cp -r "$work/two" "$work/beside" && printf "1 0 0 0.5\n0 1 0 0\n0 0 1 0.7\n0 0 0 1\n" > "$work/beside/annotated_poses/cylinder/000000.txt"
+"$track" --sequence "$work/beside" --out "$work/beside_out" > "$work/beside.txt" 2>&1 || fail "beside: exit $?: $(cat "$work/beside.txt")"
+grep -q "frame 000000 cylinder not started: .* degrees beside the object's mask" "$work/beside.txt" || fail "beside: $(cat "$work/beside.txt")"
+grep "^000000," "$work/beside_out/cylinder/track.csv" | grep -q "^000000,not_started,.*degrees beside" \
+  || fail "beside: $(head -2 "$work/beside_out/cylinder/track.csv")"
+grep -q "^\[cylinder\] 7 frames from frame 000001" "$work/beside.txt" || fail "beside: the cylinder did not start on frame 1"
+diff -r "$work/beside_out/box/poses" "$work/both/box/poses" > /dev/null || fail "beside: the box's poses changed"
+if "$track" --sequence "$work/beside" --out "$work/beside_strict" --strict --quiet > /dev/null 2>&1; then
+  fail "--strict went on past a start pose beside the object"
+fi
 if "$synth" --out "$work/w" --labels 2> "$work/labels_one.txt" > /dev/null; then fail "--labels with one object was accepted"; fi
 grep -q -- "--labels needs --objects 2 or 3" "$work/labels_one.txt" || fail "--labels alone: $(cat "$work/labels_one.txt")"
 echo "multi-object command line: ok"
