@@ -456,10 +456,9 @@ void run(bt::MultiObjectTracker& tracker, const bt::io::RgbdSequence& sequence, 
     std::vector<std::optional<bt::TrackResult>> results(count);
     bt::Stopwatch tracking;
     if (frame) {
-      // An object starts at its annotated pose in that frame where it has ground truth (its first
-      // frame stays strict), else at the identity.
-      // A start pose that the frame contradicts (checkStartFrame) keeps the object from starting
-      // there, with the reason, unless it is the only object's first frame or --strict.
+      // An object starts at its annotated pose in that frame where it has ground truth, else at
+      // the identity. A start pose that the frame contradicts (checkStartFrame) keeps the object
+      // from starting there, with the reason, unless it is the only object's first frame or --strict.
       std::vector<bt::SE3d> start(count);
       for (std::size_t k = 0; k < count; ++k) {
         if (tracker.started(k) || !given[k] || cv::countNonZero(*given[k]) == 0 || !sequence.hasGroundTruth(objects[k]))

@@ -663,6 +663,17 @@ TEST_CASE("a first frame without depth under its mask or with a pose its depth c
   };
   CHECK(message(1.0, beside(0.3)).find("degrees beside the object's mask, which spans") != std::string::npos);
   CHECK(message(1.0, beside(0.05)) == "accepted");
+  // A mask of one pixel: an origin within kStartMinSpanDeg of its ray passes, one farther does not.
+  cv::Mat one_pixel = cv::Mat::zeros(f.mask.size(), CV_8UC1);
+  int u = 0, v = 0;
+  REQUIRE(short_scene.camera().pixelOf(f.T_cam_obj.translation().cast<float>(), u, v));
+  one_pixel.at<uchar>(v, u) = 255;
+  const auto with_one_pixel = [&](const bt::SE3d& T_cam_obj) {
+    const bt::RgbdFrame frame = bt::makeFrame("000000", f.color, f.depth, one_pixel, short_scene.camera());
+    bt::checkStartFrame(frame, T_cam_obj);
+  };
+  CHECK_NOTHROW(with_one_pixel(beside(0.005)));  // 0.4 degrees at 0.73 m
+  CHECK_THROWS_AS(with_one_pixel(beside(0.05)), bt::InputError);  // 3.9 degrees
 }
 
 TEST_CASE("makeTracker refuses combinations that do not exist, naming the keys") {

@@ -21,13 +21,17 @@ namespace bundletrack {
 /// the object's depth: a factor of 2 allows an object as deep as it is far from the camera.
 inline constexpr double kStartDepthFactor = 2.0;
 
+/// Degrees: the least span of a mask that checkStartFrame's test beside the mask allows for (a
+/// mask of a few pixels says little of where the object's middle is; 10 cm at 3 m spans 1.9).
+inline constexpr double kStartMinSpanDeg = 1.0;
+
 /// The first frame must show the object's surface: depth readings under its mask (after
 /// filtering, which drops readings outside depth.min_depth - depth.max_depth). A start pose
 /// T_cam_obj must agree with them:
 /// - its origin in front of the camera;
 /// - seen from the camera, on the object: an origin on or inside the object lies on a ray through
 ///   its silhouette, so it may lie beside the mask's box of rays by at most the box's size (the
-///   mask may cover only part of the object);
+///   mask may cover only part of the object), or kStartMinSpanDeg for a tiny mask;
 /// - at the depth of the object: its depth t_z and the median depth under the mask (the visible
 ///   surface) differ by at most kStartDepthFactor either way. Otherwise the depth and the pose
 ///   are in different units -- the mistake no range test sees when a near scene read 5 times too
@@ -61,7 +65,7 @@ inline void checkStartFrame(const RgbdFrame& frame, const SE3d& T_cam_obj) {
                                  ", behind the camera (T_cam_obj maps object points into the camera frame: "
                                  "is it the inverse, T_obj_cam?)");
   }
-  const double size = (high - low).maxCoeff();
+  const double size = std::max((high - low).maxCoeff(), std::tan(radians(kStartMinSpanDeg)));
   const Eigen::Array2d ray(origin.x() / origin.z(), origin.y() / origin.z());
   const double off = std::max((low - ray).maxCoeff(), (ray - high).maxCoeff());
   if (off > size) {
