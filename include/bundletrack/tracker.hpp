@@ -63,8 +63,7 @@ class Tracker {
   }
 
   /// Starts the track: the first frame with its mask and pose is keyframe 0, the graph's fixed node.
-  /// A frame without depth under its mask, or a pose its depth contradicts, is refused
-  /// (checkStartFrame).
+  /// A frame without depth under its mask, or a pose it contradicts, is refused (checkStartFrame).
   TrackResult initialize(const RgbdFrame& frame, const SE3d& T_cam_obj = {}) {
     checkStartFrame(frame, T_cam_obj);
     clock_.start(&StageTimings::mask);

@@ -29,9 +29,9 @@ class CoarseTracker {
                          Settings settings = Settings())
       : correspondences_(std::move(correspondences)), registration_(std::move(registration)), settings_(settings) {}
 
-  /// Starts a track at frame 0 with its known pose (identity makes the first camera the object frame;
-  /// a frame without depth under the mask or a pose its depth contradicts is
-  /// refused: checkStartFrame).
+  /// Starts a track at frame 0 with its known pose (identity makes the first camera the object
+  /// frame). A frame without depth under its mask, or a pose it contradicts, is refused
+  /// (checkStartFrame).
   TrackResult initialize(const RgbdFrame& frame, const SE3d& T_cam_obj = {}) {
     if (frame.mask.empty() || cv::countNonZero(frame.mask) == 0)
       throw InputError("frame " + frame.name, "the first frame needs a non-empty object mask");
