@@ -1,5 +1,6 @@
 #pragma once
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <vector>
@@ -94,28 +95,43 @@ inline cv::Mat smoothDepth(const cv::Mat& depth, const DepthFilterSettings& s, c
       spatial[std::size_t((dv + r) * width + du + r)] =
           std::exp(-float(du * du + dv * dv) / (2.0f * s.smooth_sigma * s.smooth_sigma));
   const bool plane = s.smoothing == DepthSmoothing::PlaneFit;
+  // The first moments are gathered a row at a time, neighbour offset by neighbour offset, so that
+  // one pixel's sums run in the same order as a pixel-by-pixel loop (the same floats) while the
+  // compiler vectorises across the row. Outside the image the border reads 0, which the window
+  // test refuses as it refuses an invalid reading.
+  cv::Mat padded;
+  cv::copyMakeBorder(depth, padded, r, r, r, r, cv::BORDER_CONSTANT, cv::Scalar(0.0f));
   cv::parallel_for_(cv::Range(0, depth.rows), [&](const cv::Range& rows) {
+    const auto cols = std::size_t(depth.cols);
+    std::vector<float> windows(cols), w0s(cols), wzs(cols);
+    std::vector<int> admitted_counts(cols);
     for (int v = rows.start; v < rows.end; ++v) {
-      const int v0 = std::max(0, v - r), v1 = std::min(depth.rows - 1, v + r);
-      for (int u = 0; u < depth.cols; ++u) {
-        const float z = depth.ptr<float>(v)[u];
-        if (z <= 0.0f) continue;
-        const int u0 = std::max(0, u - r), u1 = std::min(depth.cols - 1, u + r);
-        const float window = noise.widen(s.smooth_depth_window, z);
-        // Weighted moments of the admitted neighbours (offsets du, dv, dz from the pixel). Invalid
-        // readings are 0 and fail the window test, which keeps the inner loops branch-free.
-        float w0 = 0, wz = 0;
-        int admitted = 0;
-        for (int vv = v0; vv <= v1; ++vv) {
-          const float* row = depth.ptr<float>(vv);
-          const float* w = &spatial[std::size_t((vv - v + r) * width - u + r)];
-          for (int uu = u0; uu <= u1; ++uu) {
-            const float dz = row[uu] - z;
-            const bool in = std::abs(dz) < window;
-            admitted += in;
-            w0 += float(in) * w[uu], wz += float(in) * w[uu] * dz;
+      const float* centre = padded.ptr<float>(v + r) + r;
+      for (std::size_t u = 0; u < cols; ++u) windows[u] = noise.widen(s.smooth_depth_window, centre[u]);
+      std::fill(w0s.begin(), w0s.end(), 0.0f);
+      std::fill(wzs.begin(), wzs.end(), 0.0f);
+      std::fill(admitted_counts.begin(), admitted_counts.end(), 0);
+      for (int dv = -r; dv <= r; ++dv) {
+        for (int du = -r; du <= r; ++du) {
+          const float* row = padded.ptr<float>(v + r + dv) + r + du;
+          const float w = spatial[std::size_t((dv + r) * width + du + r)];
+          for (std::size_t u = 0; u < cols; ++u) {
+            const float dz = row[u] - centre[u];
+            const bool in = std::abs(dz) < windows[u];
+            const float weight = in ? w : 0.0f;  // a select, which the compiler vectorises
+            admitted_counts[u] += in ? 1 : 0;
+            w0s[u] += weight, wzs[u] += weight * dz;
           }
         }
+      }
+      const int v0 = std::max(0, v - r), v1 = std::min(depth.rows - 1, v + r);
+      for (int u = 0; u < depth.cols; ++u) {
+        const float z = centre[u];
+        if (z <= 0.0f) continue;
+        const int u0 = std::max(0, u - r), u1 = std::min(depth.cols - 1, u + r);
+        const float window = windows[std::size_t(u)];
+        const float w0 = w0s[std::size_t(u)], wz = wzs[std::size_t(u)];
+        const int admitted = admitted_counts[std::size_t(u)];
         float offset = wz / w0;  // the centre itself is always admitted
         // With every neighbour of the whole window admitted the design is symmetric (the first
         // moments vanish), and the plane's value at the pixel is the mean: the plane's other

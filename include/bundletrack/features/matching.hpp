@@ -2,7 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
-#include <numeric>
+#include <cstdint>
 #include <optional>
 #include <vector>
 
@@ -96,30 +96,44 @@ inline std::vector<FeatureMatch> mutualMatches(const std::vector<TwoNearest>& fo
 }
 
 /// Guided matching under a known relative pose: mutual nearest neighbours with the ratio test in
-/// both directions, among the pairs the gate admits only. Sorted by the first index. Each of
-/// first's keypoints is tested only against second's within the gate's reach in x (second's sorted
-/// by x once; TwoNearest does not depend on the order of its candidates).
+/// both directions, among the pairs the gate admits only. Sorted by the first index. Second's
+/// keypoints are sorted once into rows of the gate's reach in y, by x within a row, so each of
+/// first's keypoints is tested only against those of its row and the two beside it that lie
+/// within reach in x (TwoNearest does not depend on the order of its candidates).
 inline std::vector<FeatureMatch> matchGuided(const FrameFeatures& first, const FrameFeatures& second,
                                              const MatchSettings& settings, const MatchGate& gate) {
   const int n1 = int(first.size()), n2 = int(second.size());
   std::vector<TwoNearest> forward(static_cast<std::size_t>(n1)), backward(static_cast<std::size_t>(n2));
   const GateTest test(gate, first, second);
-  std::vector<int> by_x(static_cast<std::size_t>(n2));
-  std::iota(by_x.begin(), by_x.end(), 0);
-  std::sort(by_x.begin(), by_x.end(), [&](int a, int b) { return second.points[std::size_t(a)].x() < second.points[std::size_t(b)].x(); });
-  std::vector<float> sorted_x;
-  for (const int j : by_x) sorted_x.push_back(second.points[std::size_t(j)].x());
   const float reach = test.reach();
+  // Rows in double: two points within reach in y lie in the same or neighbouring rows only if the
+  // division does not round them apart (reach keeps a 1e-5 margin; float would round by more
+  // than that at y / reach ~ 1e3).
+  const auto rowOf = [&](float y) { return std::int64_t(std::floor(double(y) / double(reach))); };
+  struct Candidate {
+    std::int64_t row;
+    float x;
+    int index;
+    bool operator<(const Candidate& other) const { return row != other.row ? row < other.row : x < other.x; }
+  };
+  std::vector<Candidate> candidates;
+  candidates.reserve(static_cast<std::size_t>(n2));
+  for (int j = 0; j < n2; ++j) {
+    const Eigen::Vector3f& p = second.points[std::size_t(j)];
+    candidates.push_back({rowOf(p.y()), p.x(), j});
+  }
+  std::sort(candidates.begin(), candidates.end());
   for (int i = 0; i < n1; ++i) {
     const GateTest::Moved moved = test.move(i);
-    const auto from = std::lower_bound(sorted_x.begin(), sorted_x.end(), moved.point.x() - reach);
-    const auto to = std::upper_bound(from, sorted_x.end(), moved.point.x() + reach);
-    for (auto k = from - sorted_x.begin(); k < to - sorted_x.begin(); ++k) {
-      const int j = by_x[std::size_t(k)];
-      if (!test.admits(moved, j)) continue;
-      const float distance = descriptorDistance(first.descriptors, i, second.descriptors, j, first.norm_type);
-      forward[std::size_t(i)].offer(distance, j);
-      backward[std::size_t(j)].offer(distance, i);
+    const std::int64_t row = rowOf(moved.point.y());
+    for (std::int64_t r = row - 1; r <= row + 1; ++r) {
+      for (auto k = std::lower_bound(candidates.begin(), candidates.end(), Candidate{r, moved.point.x() - reach, 0});
+           k != candidates.end() && k->row == r && k->x <= moved.point.x() + reach; ++k) {
+        if (!test.admits(moved, k->index)) continue;
+        const float distance = descriptorDistance(first.descriptors, i, second.descriptors, k->index, first.norm_type);
+        forward[std::size_t(i)].offer(distance, k->index);
+        backward[std::size_t(k->index)].offer(distance, i);
+      }
     }
   }
   return mutualMatches(forward, backward, first, second, settings.ratio, std::nullopt);

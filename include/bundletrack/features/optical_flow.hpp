@@ -66,8 +66,12 @@ inline FollowedFeatures followFeatures(const cv::Mat& last_gray, const cv::Mat& 
   std::vector<float> error;
   const cv::Size window(settings.window, settings.window);
   const cv::TermCriteria stop(cv::TermCriteria::COUNT | cv::TermCriteria::EPS, 30, 0.01);
-  cv::calcOpticalFlowPyrLK(before, after, start, forward, found_forward, error, window, settings.levels, stop);
-  cv::calcOpticalFlowPyrLK(after, before, forward, back, found_back, error, window, settings.levels, stop);
+  // Each image's pyramid (with its derivatives) serves both directions: built once, not twice.
+  std::vector<cv::Mat> before_pyramid, after_pyramid;
+  cv::buildOpticalFlowPyramid(before, before_pyramid, window, settings.levels, true);
+  cv::buildOpticalFlowPyramid(after, after_pyramid, window, settings.levels, true);
+  cv::calcOpticalFlowPyrLK(before_pyramid, after_pyramid, start, forward, found_forward, error, window, settings.levels, stop);
+  cv::calcOpticalFlowPyrLK(after_pyramid, before_pyramid, forward, back, found_back, error, window, settings.levels, stop);
   std::vector<cv::Point2f> pixels;
   std::vector<int> followed_from;
   for (std::size_t k = 0; k < start.size(); ++k) {

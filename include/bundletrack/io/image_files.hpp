@@ -1,9 +1,9 @@
 #pragma once
 
 #include <algorithm>
+#include <cstdint>
 #include <cstdio>
 #include <filesystem>
-#include <iterator>
 #include <string>
 #include <vector>
 
@@ -73,7 +73,11 @@ inline cv::Mat decodeImage(const std::vector<uchar>& bytes, int flags, const std
 /// Decodes an image file; a missing or unreadable file is an InputError too.
 inline cv::Mat readImage(const std::filesystem::path& path, int flags) {
   std::ifstream in = openForReading(path, std::ios::binary);
-  const std::vector<uchar> bytes{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+  std::vector<uchar> bytes;
+  std::error_code unknown_size;
+  if (const std::uintmax_t size = std::filesystem::file_size(path, unknown_size); !unknown_size) bytes.reserve(size);
+  char block[1 << 16];  // read in blocks: a file's size may change, or be unknown (a pipe)
+  while (in.read(block, sizeof(block)) || in.gcount() > 0) bytes.insert(bytes.end(), block, block + in.gcount());
   return decodeImage(bytes, flags, path);
 }
 
