@@ -227,7 +227,7 @@ class ObjectOutput {
       box_ = bt::ObjectBox::bounding(model_);
     }
     csv_.open(out_ / "track.csv");
-    csv_ << "frame,status,by_surface,keypoints,followed,matches,inliers,read_ms,mask_ms,features_ms,matching_ms,ransac_ms,graph_ms,solve_ms,"
+    csv_ << "frame,status,by_surface,keypoints,followed,matches,inliers,stability,read_ms,mask_ms,features_ms,matching_ms,ransac_ms,graph_ms,solve_ms,"
             "total_ms"
          << (scored_ ? ",rotation_error_deg,translation_error_cm" : "") << (propagated_ ? ",mask_iou" : "") << ",problem\n";
   }
@@ -245,7 +245,7 @@ class ObjectOutput {
     const std::string name = sequence_.frameNames()[i];
     const bool readable = problem.empty();
     if (!result && !started) {
-      csv_ << name << ",not_started" << std::string(13 + (scored_ ? 2 : 0) + (propagated_ ? 1 : 0), ',') << ','
+      csv_ << name << ",not_started" << std::string(14 + (scored_ ? 2 : 0) + (propagated_ ? 1 : 0), ',') << ','
            << csvField(problem) << '\n';
       return result;
     }
@@ -265,7 +265,9 @@ class ObjectOutput {
     bt::io::writePose(out_ / "poses" / (name + ".txt"), result->T_cam_obj);
     const auto& t = result->timings;
     csv_ << name << ',' << bt::statusName(result->status) << ',' << result->surface_only << ',' << result->keypoints << ',' << result->followed << ','
-         << result->matches << ',' << result->inliers << ',' << read_ms << ',' << t.mask << ',' << t.features << ','
+         << result->matches << ',' << result->inliers << ',';
+    if (result->stability) csv_ << *result->stability;
+    csv_ << ',' << read_ms << ',' << t.mask << ',' << t.features << ','
          << t.matching << ',' << t.ransac << ',' << t.graph << ',' << t.solve << ',' << t.total;
     if (scored_) {
       // A frame without an annotated pose is not scored; one that could not be read scores as a failure.

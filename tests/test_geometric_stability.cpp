@@ -106,3 +106,32 @@ TEST_CASE("noisy normals make a plane look stable, and averaging 5x5 cells remov
   CHECK(bt::geometricStability(noisier) == bt::geometricStability(grid, 6));
   CHECK(bt::geometricStability(grid) == averaged);
 }
+
+TEST_CASE("pose stability: the pose graph's information about the object's origin, re-centred and scaled, is the surface's geometric stability") {
+  // A pose graph's node information in its own coordinates: point-to-plane rows [m, a x m] of the
+  // right perturbation T_cam_obj exp(d), a and m the points and normals in the object frame,
+  // whose origin lies far from the points. Re-centred on their centroid and scaled by their RMS
+  // radius, its evenness must be what geometricStability computes from the camera-frame surface
+  // about its centroid (exact normals: no averaging).
+  const bt::SE3d T_cam_obj(bt::SO3d::exp(Eigen::Vector3d(0.4, 0.9, -0.3)), Eigen::Vector3d(0.2, -0.4, 0.3));
+  for (const auto& shape : {boxCorner, cylinder, sphere}) {
+    const bt::SurfaceGrid grid = gridOf(40, shape);
+    Eigen::Matrix<double, 6, 6> information = Eigen::Matrix<double, 6, 6>::Zero();
+    for (const cv::Point& cell : grid.cells) {
+      const cv::Vec3f& p = grid.point(cell);
+      const cv::Vec3f& n = grid.normal(cell);
+      const Eigen::Vector3d a = T_cam_obj.inverse() * Eigen::Vector3d(p[0], p[1], p[2]);
+      const Eigen::Vector3d m = T_cam_obj.rotation().inverse() * Eigen::Vector3d(n[0], n[1], n[2]);
+      Eigen::Matrix<double, 6, 1> row;
+      row << m, a.cross(m);
+      information += row * row.transpose();
+    }
+    const bt::SurfaceSpread spread = bt::spreadOf(grid);
+    const double expected = bt::geometricStability(grid, 0);
+    const double reported = bt::poseStability(information, T_cam_obj.inverse() * spread.centroid, spread.rms_radius);
+    CHECK(reported == doctest::Approx(expected).epsilon(1e-6));
+    // Without re-centring the box corner's turns about the far origin read as shifts.
+    if (expected > 0.1) CHECK(bt::evenness(information) < 0.5 * expected);
+  }
+  CHECK(bt::poseStability(Eigen::Matrix<double, 6, 6>::Zero(), Eigen::Vector3d::Zero(), 0.1) == 0.0);
+}

@@ -31,6 +31,7 @@ struct Run {
   int lost = 0, tracked = 0, by_surface = 0, followed = 0;
   double mean_mask_iou = 0.0;  ///< against the renderer's mask where the filtered depth is valid
   std::vector<bt::SE3d> poses;
+  std::vector<double> stabilities;  ///< of the frames that report one
 };
 
 /// Tracks the scene; with `first_mask_only` every frame after the first comes without its mask.
@@ -52,6 +53,7 @@ Run track(Tracker&& tracker, const synth::SyntheticScene& scene, const std::vect
     run.tracked += result.status == bt::TrackStatus::Tracked;
     run.by_surface += result.surface_only;
     run.followed += result.followed > 0;
+    if (result.stability) run.stabilities.push_back(*result.stability);
     if (!result.mask.empty()) run.mean_mask_iou += bt::maskIoU(result.mask, f.mask & (frame.depth > 0.0f));
     truth.push_back(f.T_cam_obj);
     estimate.push_back(result.T_cam_obj);
@@ -270,6 +272,31 @@ TEST_CASE("feature-only and dense-only energies compose and track, and dense alo
   const synth::SyntheticScene box_scene(box);
   const Run features = track(FeatureOnly(box.camera.cast<float>()), box_scene, box_scene.objectMesh().sampleSurface(1000, 1));
   CHECK(features.score.adds_auc >= 95.0);
+}
+
+TEST_CASE("a frame's reported stability: a textured box is held in every direction, a textureless can's turn about its axis is not" * doctest::test_suite("end_to_end")) {
+  // Nothing but the normals' noise holds a textureless can's turn about its axis (its surface,
+  // outline and shading are the same at every turn), while the box's faces, outline and texture
+  // hold every direction: its reported stability must be several times the can's.
+  const auto median = [](std::vector<double> values) {
+    REQUIRE(!values.empty());
+    std::nth_element(values.begin(), values.begin() + std::ptrdiff_t(values.size() / 2), values.end());
+    return values[values.size() / 2];
+  };
+  synth::SyntheticSequenceSettings settings;
+  settings.frames = 20;
+  const synth::SyntheticScene box(settings);
+  settings.shape = synth::Shape::Cylinder;
+  settings.textureless = true;
+  const synth::SyntheticScene can(settings);
+  const Run held = track(bt::DefaultTracker(settings.camera.cast<float>()), box, box.objectMesh().sampleSurface(1000, 1));
+  const Run free = track(bt::DefaultTracker(settings.camera.cast<float>()), can, can.objectMesh().sampleSurface(1000, 1));
+  CHECK(int(held.stabilities.size()) == held.tracked - 1);  // every graph-tracked frame but the first (no graph)
+  CHECK(int(free.stabilities.size()) == free.tracked - 1);
+  const double box_median = median(held.stabilities), can_median = median(free.stabilities);
+  MESSAGE("median stability: box " << box_median << ", textureless can " << can_median);
+  CHECK(box_median > 0.02);
+  CHECK(can_median < box_median / 5.0);
 }
 
 TEST_CASE("keypoints on demand: frames the surface holds skip them and track as well as keypoints on every frame" * doctest::test_suite("end_to_end")) {

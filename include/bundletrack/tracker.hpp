@@ -504,12 +504,24 @@ class Tracker {
         pool_[ctx.graph.pool_indices[n]].T_cam_obj = ctx.graph.poses[n];
       ctx.result.T_cam_obj = ctx.graph.poses.back();
       ctx.result.status = TrackStatus::Tracked;
+      ctx.result.stability = stabilityOf(ctx);
       return true;
     }
     if (!ctx.coarse.found || ctx.recovering) return false;
     ctx.result.T_cam_obj = ctx.coarse.T_cam_obj;
     ctx.result.status = TrackStatus::CoarseOnly;
+    ctx.result.stability.reset();
     return true;
+  }
+
+  /// poseStability of the frame's node, the graph's last, at the last linearisation; its points'
+  /// centroid moved into the object frame under the graph's pose.
+  double stabilityOf(const FrameContext& ctx) const {
+    const Eigen::MatrixXd& information = ctx.optimisation.information;
+    if (information.rows() < 6) return 0.0;
+    const SurfaceSpread spread = spreadOf(ctx.current.surface);
+    return poseStability(information.bottomRightCorner<6, 6>(), ctx.graph.poses.back().inverse() * spread.centroid,
+                         spread.rms_radius);
   }
 
   /// Followed keypoints carry the descriptors of the frame their chain began on, which a turned

@@ -71,6 +71,8 @@ cp -r "$work/two" "$work/beside" && printf "1 0 0 0.5\n0 1 0 0\n0 0 1 0.7\n0 0 0
 grep -q "frame 000000 cylinder not started: .* degrees beside the object's mask" "$work/beside.txt" || fail "beside: $(cat "$work/beside.txt")"
 grep "^000000," "$work/beside_out/cylinder/track.csv" | grep -q "^000000,not_started,.*degrees beside" \
   || fail "beside: $(head -2 "$work/beside_out/cylinder/track.csv")"
+/usr/bin/python3 -c 'import csv, sys; sys.exit(len({len(row) for row in csv.reader(open(sys.argv[1]))}) != 1)' \
+  "$work/beside_out/cylinder/track.csv" || fail "beside: track.csv rows of different lengths: $(head -3 "$work/beside_out/cylinder/track.csv")"
 grep -q "^\[cylinder\] 7 frames from frame 000001" "$work/beside.txt" || fail "beside: the cylinder did not start on frame 1"
 diff -r "$work/beside_out/box/poses" "$work/both/box/poses" > /dev/null || fail "beside: the box's poses changed"
 if "$track" --sequence "$work/beside" --out "$work/beside_strict" --strict --quiet > /dev/null 2>&1; then

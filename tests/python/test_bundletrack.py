@@ -136,6 +136,8 @@ def test_result_fields(box):
     assert np.array_equal(first.pose, np.eye(4))  # no pose given: the identity
     result = tracker.track(*files(seq, 1))
     assert result.status == "tracked" and result.tracked
+    assert first.stability is None  # the first frame has no graph
+    assert isinstance(result.stability, float) and 0.0 < result.stability <= 1.0
     assert result.pose.shape == (4, 4) and result.pose.dtype == np.float64
     assert set(result.timings) == {"mask", "features", "matching", "ransac", "graph", "solve", "total"}
     assert result.mask.shape == (480, 640) and set(np.unique(result.mask)) <= {0, 255}

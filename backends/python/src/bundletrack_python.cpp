@@ -189,6 +189,7 @@ struct Result {
   int keypoints, matches, inliers;
   bool by_surface;
   int followed;
+  py::object stability;
   py::dict timings;
   py::object mask;
 };
@@ -200,7 +201,7 @@ Result resultOf(const bt::TrackResult& r) {
                                  {"ransac", t.ransac}, {"graph", t.graph}, {"solve", t.solve}, {"total", t.total}})
     timings[name] = ms;
   return {matrixOf(r.T_cam_obj), std::string(bt::statusName(r.status)), r.keypoints, r.matches, r.inliers, r.surface_only,
-          r.followed, timings, r.mask.empty() ? py::object(py::none()) : py::object(arrayOf<std::uint8_t>(r.mask))};
+          r.followed, r.stability ? py::object(py::float_(*r.stability)) : py::object(py::none()), timings, r.mask.empty() ? py::object(py::none()) : py::object(arrayOf<std::uint8_t>(r.mask))};
 }
 
 /// Shows a caution of the readers (e.g. checkDepthScale's) as a Python UserWarning.
@@ -542,6 +543,8 @@ PYBIND11_MODULE(bundletrack, m) {
       .def_readonly("inliers", &Result::inliers, "RANSAC inliers among them")
       .def_readonly("by_surface", &Result::by_surface, "tracked by the dense term alone (keypoints on demand)")
       .def_readonly("followed", &Result::followed, "keypoints followed from the last frame by optical flow (keypoints on demand; 0: none)")
+      .def_readonly("stability", &Result::stability,
+                    "how evenly the data hold the pose, up to 1; ~0 where a direction is free; None without the graph's pose")
       .def_readonly("timings", &Result::timings, "milliseconds per stage: mask, features, matching, ransac, graph, solve, total")
       .def_readonly("mask", &Result::mask, "HxW uint8 mask the frame was tracked with (0 / 255), or None")
       .def("__repr__", [](const Result& r) {

@@ -33,6 +33,7 @@ struct OptimizationReport {
   double final_cost = 0.0;  ///< energy at the last linearisation
   int residuals = 0;  ///< in the last linearisation
   std::vector<SolveReport> solves;  ///< the linear solver's report of every step, taken or not
+  Eigen::MatrixXd information;  ///< H of the last linearisation, over the free nodes (empty when none)
 };
 
 /// The energy and its normal equations at given poses.
@@ -143,6 +144,7 @@ OptimizationReport optimizePoseGraph(const Problem& problem, const Solver& solve
     report.iterations = iteration + 1;
     if (detail::negligible(step, settings)) break;
   }
+  report.information = std::move(at.H);
   return report;
 }
 

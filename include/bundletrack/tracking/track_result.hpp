@@ -47,6 +47,11 @@ struct TrackResult {
   StageTimings timings;
   bool surface_only = false;  ///< tracked by the dense term alone (keypoints on demand)
   int followed = 0;  ///< keypoints followed into this frame from the one before by optical flow (when it used them)
+  /// How evenly the data hold the pose (poseStability of the frame's information in the accepted
+  /// graph, every term as the energy weighs it): up to 1 when every direction is held alike, ~0
+  /// where one is free (a textureless mug's turn with its handle hidden). None without a graph's
+  /// pose (the first frame, coarse, lost).
+  std::optional<double> stability = std::nullopt;
 };
 
 }  // namespace bundletrack
