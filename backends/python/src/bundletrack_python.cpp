@@ -200,8 +200,10 @@ Result resultOf(const bt::TrackResult& r) {
   for (const auto& [name, ms] : {std::pair{"mask", t.mask}, {"features", t.features}, {"matching", t.matching},
                                  {"ransac", t.ransac}, {"graph", t.graph}, {"solve", t.solve}, {"total", t.total}})
     timings[name] = ms;
+  const py::object stability = r.stability ? py::object(py::float_(*r.stability)) : py::object(py::none());
+  const py::object mask = r.mask.empty() ? py::object(py::none()) : py::object(arrayOf<std::uint8_t>(r.mask));
   return {matrixOf(r.T_cam_obj), std::string(bt::statusName(r.status)), r.keypoints, r.matches, r.inliers, r.surface_only,
-          r.followed, r.stability ? py::object(py::float_(*r.stability)) : py::object(py::none()), timings, r.mask.empty() ? py::object(py::none()) : py::object(arrayOf<std::uint8_t>(r.mask))};
+          r.followed, stability, timings, mask};
 }
 
 /// Shows a caution of the readers (e.g. checkDepthScale's) as a Python UserWarning.
