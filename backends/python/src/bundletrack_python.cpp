@@ -546,7 +546,8 @@ PYBIND11_MODULE(bundletrack, m) {
       .def_readonly("by_surface", &Result::by_surface, "tracked by the dense term alone (keypoints on demand)")
       .def_readonly("followed", &Result::followed, "keypoints followed from the last frame by optical flow (keypoints on demand; 0: none)")
       .def_readonly("stability", &Result::stability,
-                    "how evenly the data hold the pose, up to 1; ~0 where a direction is free; None without the graph's pose")
+                    "how evenly the data hold the pose, up to 1; ~0 where one direction is held far less than the "
+                    "strongest (a ratio, not an uncertainty); None without the graph's pose")
       .def_readonly("timings", &Result::timings, "milliseconds per stage: mask, features, matching, ransac, graph, solve, total")
       .def_readonly("mask", &Result::mask, "HxW uint8 mask the frame was tracked with (0 / 255), or None")
       .def("__repr__", [](const Result& r) {

@@ -49,8 +49,8 @@ struct TrackResult {
   int followed = 0;  ///< keypoints followed into this frame from the one before by optical flow (when it used them)
   /// How evenly the data hold the pose (poseStability of the frame's information in the accepted
   /// graph, every term as the energy weighs it): up to 1 when every direction is held alike, ~0
-  /// where one is free (a textureless mug's turn with its handle hidden). None without a graph's
-  /// pose (the first frame, coarse, lost).
+  /// where one is held far less than the strongest (a textureless mug's turn with its handle
+  /// hidden); a ratio, not an uncertainty. None without a graph's pose (first frame, coarse, lost).
   std::optional<double> stability = std::nullopt;
 };
 
