@@ -334,12 +334,8 @@ class Tracker {
   std::optional<Placement> movedOntoObject(const RgbdFrame& masked) const {
     const SurfaceGrid& seen = last_->surface;
     if (seen.cells.empty()) return std::nullopt;
-    Eigen::Vector3d before = Eigen::Vector3d::Zero(), now = Eigen::Vector3d::Zero();
-    for (const cv::Point& cell : seen.cells) {
-      const cv::Vec3f& p = seen.point(cell);
-      before += Eigen::Vector3d(p[0], p[1], p[2]);
-    }
-    before /= double(seen.cells.size());
+    const Eigen::Vector3d before = spreadOf(seen).centroid;
+    Eigen::Vector3d now = Eigen::Vector3d::Zero();
     const int step = grid_step_;
     int count = 0;
     for (int v = 0; v < masked.mask.rows; v += step) {
