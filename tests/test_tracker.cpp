@@ -114,15 +114,18 @@ TEST_CASE("brightness keeps a small textured mug's turn at 2 m where its surface
   // The stress matrix's A_mug_2m_textured: a 10 cm mug 2 m away fills about 20 x 20 pixels, and
   // structured-light depth there (7 mm spread, 13 mm disparity steps) does not see its curvature
   // nor much of its handle: the turn about its axis is left to the texture. Without it the turn
-  // is a random walk whose end differs from one noise seed to the next, so the mean over three
-  // seeds (textures and sensor noise) is compared. The silhouette term is off in both: the
-  // handle's outline holds the turn too, and this test weighs brightness alone.
+  // is a random walk whose end differs from one noise seed to the next, so the mean over five
+  // seeds (textures and sensor noise) is compared: brightness turns less on four of them and
+  // further on one (seed 4: 27.9 against 20.3 degrees), 12.3 against 22.1 degrees in the mean.
+  // Three seeds left the means within a few hundredths of a degree of the bound, which such a
+  // walk does not support. The silhouette term is off in both: the handle's outline holds the
+  // turn too, and this test weighs brightness alone.
   bt::Config with;
   with.silhouette_weight = 0.0;
   bt::Config without = with;
   without.photometric_weight = 0.0;
   double surface_deg = 0.0, brightness_deg = 0.0;
-  for (const unsigned seed : {2u, 3u, 4u}) {
+  for (const unsigned seed : {2u, 3u, 4u, 5u, 6u}) {
     synth::SyntheticSequenceSettings settings;
     settings.shape = synth::Shape::Mug;
     settings.size = 0.10;
@@ -137,8 +140,8 @@ TEST_CASE("brightness keeps a small textured mug's turn at 2 m where its surface
             << " deg, with it " << brightness.score.rotation_error_deg << " deg; ADD-S " << brightness.score.adds_auc);
     CHECK(brightness.lost == 0);
     CHECK(brightness.score.adds_auc >= 95.0);
-    surface_deg += surface.score.rotation_error_deg / 3.0;
-    brightness_deg += brightness.score.rotation_error_deg / 3.0;
+    surface_deg += surface.score.rotation_error_deg / 5.0;
+    brightness_deg += brightness.score.rotation_error_deg / 5.0;
   }
   CHECK(brightness_deg < 0.6 * surface_deg);
 }
