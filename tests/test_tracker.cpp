@@ -5,6 +5,7 @@
 #include <doctest/doctest.h>
 
 #include <algorithm>
+#include <iterator>
 #include <limits>
 #include <numeric>
 #include <random>
@@ -124,8 +125,10 @@ TEST_CASE("brightness keeps a small textured mug's turn at 2 m where its surface
   with.silhouette_weight = 0.0;
   bt::Config without = with;
   without.photometric_weight = 0.0;
+  constexpr unsigned kSeeds[] = {2, 3, 4, 5, 6};
+  constexpr double kRuns = double(std::size(kSeeds));
   double surface_deg = 0.0, brightness_deg = 0.0;
-  for (const unsigned seed : {2u, 3u, 4u, 5u, 6u}) {
+  for (const unsigned seed : kSeeds) {
     synth::SyntheticSequenceSettings settings;
     settings.shape = synth::Shape::Mug;
     settings.size = 0.10;
@@ -140,8 +143,8 @@ TEST_CASE("brightness keeps a small textured mug's turn at 2 m where its surface
             << " deg, with it " << brightness.score.rotation_error_deg << " deg; ADD-S " << brightness.score.adds_auc);
     CHECK(brightness.lost == 0);
     CHECK(brightness.score.adds_auc >= 95.0);
-    surface_deg += surface.score.rotation_error_deg / 5.0;
-    brightness_deg += brightness.score.rotation_error_deg / 5.0;
+    surface_deg += surface.score.rotation_error_deg / kRuns;
+    brightness_deg += brightness.score.rotation_error_deg / kRuns;
   }
   CHECK(brightness_deg < 0.6 * surface_deg);
 }
