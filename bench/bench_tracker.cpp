@@ -16,12 +16,15 @@
 #include <cstdio>
 #include <fstream>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "command_line.hpp"
 
 #include "bundletrack/core/frame_memory.hpp"
+#include "bundletrack/core/image_region.hpp"
+#include "bundletrack/io/frame_ahead.hpp"
 #include "bundletrack/io/read_ahead.hpp"
 #include "bundletrack/io/rgbd_sequence.hpp"
 #include "bundletrack/runtime/make_tracker.hpp"
@@ -76,11 +79,24 @@ std::pair<double, double> residentMemoryMiB() {
   return {rss, peak};
 }
 
-/// A frame as decoded (or rendered) and its pose where known.
+/// A frame as decoded (or rendered), preprocessed ahead over its mask's region (the tracker's once
+/// started: frameAhead), and its pose where known.
 struct Input {
-  bt::RawFrame raw;
+  bt::io::FrameAhead frame;
   bt::SE3d pose;
 };
+
+/// makeFrame with the default settings, as the benchmark's tracker preprocesses.
+auto preprocessor(const bt::PinholeCameraf& camera) {
+  return [camera](bt::RawFrame raw, const cv::Rect& region) { return bt::makeFrame(std::move(raw), camera, {}, region); };
+}
+
+/// On the reading thread: the frame, preprocessed over its mask's region where it has a mask.
+bt::io::FrameAhead ahead(bt::RawFrame raw, const bt::PinholeCameraf& camera) {
+  const std::optional<cv::Rect> foretold =
+      raw.mask.empty() ? std::nullopt : std::optional(bt::maskRegion(raw.mask, raw.color.size()));
+  return bt::io::frameAhead(std::move(raw), foretold, preprocessor(camera));
+}
 
 template <typename ReadAt>
 Stages track(bt::AnyTracker& tracker, const bt::PinholeCameraf& camera, std::size_t frames, int memory_every,
@@ -96,8 +112,8 @@ Stages track(bt::AnyTracker& tracker, const bt::PinholeCameraf& camera, std::siz
   for (std::size_t i = 0; i < frames; ++i) {
     bt::Stopwatch read;
     Input input = inputs.next();
-    const cv::Rect region = tracker.regionOfInterest(input.raw.color.size(), input.raw.mask);
-    const bt::RgbdFrame frame = bt::makeFrame(std::move(input.raw), camera, {}, region);
+    const cv::Rect region = tracker.regionOfInterest(input.frame.raw.color.size(), input.frame.raw.mask);
+    const bt::RgbdFrame frame = bt::io::preprocessedOver(std::move(input.frame), region, preprocessor(camera));
     const double read_ms = read.lap();
     const bt::TrackResult result = i == 0 ? tracker.initialize(frame, input.pose) : tracker.track(frame);
     lost += result.status == bt::TrackStatus::Lost;
@@ -205,16 +221,18 @@ int main(int argc, char** argv) {
       run("synthetic hand-held box (rendering counted as reading)", camera, std::size_t(frames), options,
           [&](std::size_t i) {
             const auto f = scene.frame(int(i));
-            return Input{{std::to_string(i), f.color, f.depth, f.mask}, f.T_cam_obj};
+            return Input{ahead({std::to_string(i), f.color, f.depth, f.mask}, camera), f.T_cam_obj};
           });
     }
     for (const auto& dir : options.sequences) {
       const bt::io::RgbdSequence sequence(dir);
+      const auto camera = sequence.camera().cast<float>();
       const double decode_ms = decodeOnlyMs(sequence, sequence.size());
       run(
-          dir, sequence.camera().cast<float>(), sequence.size(), options,
+          dir, camera, sequence.size(), options,
           [&](std::size_t i) {
-            return Input{sequence.read(i), sequence.hasGroundTruth() ? sequence.groundTruthPose(i) : bt::SE3d()};
+            return Input{ahead(sequence.read(i), camera),
+                         sequence.hasGroundTruth() ? sequence.groundTruthPose(i) : bt::SE3d()};
           },
           decode_ms);
     }

@@ -26,11 +26,13 @@
 
 #include "bundletrack/config/config_file.hpp"
 #include "bundletrack/core/frame_memory.hpp"
+#include "bundletrack/core/image_region.hpp"
 #include "bundletrack/core/start_frame_check.hpp"
 #include "bundletrack/eval/mask_iou.hpp"
 #include "bundletrack/eval/pose_metrics.hpp"
 #include "bundletrack/eval/score_table.hpp"
 #include "bundletrack/eval/sequence_score.hpp"
+#include "bundletrack/io/frame_ahead.hpp"
 #include "bundletrack/io/model_file.hpp"
 #include "bundletrack/io/read_ahead.hpp"
 #include "bundletrack/runtime/make_tracker.hpp"
@@ -385,9 +387,10 @@ class ObjectOutput {
   std::vector<bool> lost_scored_;  ///< per scored frame, for the error plot
 };
 
-/// A frame's files as read ahead: colour, depth, and each object's mask where it has one.
+/// A frame's files as read ahead (colour, depth, and each object's mask where it has one), with
+/// masks given preprocessed ahead over the region their trackers will ask for.
 struct FrameData {
-  bt::RawFrame raw;
+  bt::io::FrameAhead frame;
   std::vector<std::optional<cv::Mat>> masks;
 };
 
@@ -405,18 +408,31 @@ void run(bt::MultiObjectTracker& tracker, const bt::io::RgbdSequence& sequence, 
   std::vector<double> tracking_ms, read_ms_all, features_ms;
   int tracked_after_first = 0;
   // Files are decoded a few frames ahead on another thread; each frame is preprocessed once, only
-  // where the trackers will look (MultiObjectTracker::regionOfInterest).
+  // where the trackers will look (MultiObjectTracker::regionOfInterest). With given masks that
+  // region is foretold by the frame's masks (the union of their maskRegion): the reading thread
+  // preprocesses it too, and the frame is preprocessed again only where the trackers ask for
+  // another region (a tracker's first frame: the whole image).
+  const auto preprocess = [&](bt::RawFrame raw, const cv::Rect& region) { return sequence.preprocess(std::move(raw), region); };
   bt::io::ReadAhead<FrameData> files(sequence.size(), [&](std::size_t i) {
-    FrameData data{sequence.read(i), {}};
-    if (!several) {
-      data.masks.push_back(data.raw.mask.empty() ? std::nullopt : std::optional(data.raw.mask));
-      return data;
+    bt::RawFrame raw = sequence.read(i);
+    FrameData data;
+    if (several) {
+      std::vector<std::optional<cv::Mat>> all = sequence.masks(i);
+      for (const std::string& object : objects) {
+        const auto at = std::find(sequence.objects().begin(), sequence.objects().end(), object);
+        data.masks.push_back(std::move(all[std::size_t(at - sequence.objects().begin())]));
+      }
+    } else {
+      data.masks.push_back(raw.mask.empty() ? std::nullopt : std::optional(raw.mask));
     }
-    std::vector<std::optional<cv::Mat>> all = sequence.masks(i);
-    for (const std::string& object : objects) {
-      const auto at = std::find(sequence.objects().begin(), sequence.objects().end(), object);
-      data.masks.push_back(std::move(all[std::size_t(at - sequence.objects().begin())]));
+    raw.mask = cv::Mat();  // the trackers get their masks beside the frame
+    std::optional<cv::Rect> foretold;
+    for (const std::optional<cv::Mat>& mask : data.masks) {
+      if (propagated || !mask || cv::countNonZero(*mask) == 0) continue;
+      const cv::Rect own = bt::maskRegion(*mask, raw.color.size());
+      foretold = foretold ? *foretold | own : own;
     }
+    data.frame = bt::io::frameAhead(std::move(raw), foretold, preprocess);
     return data;
   });
   bt::Stopwatch whole_run, progress;
@@ -447,9 +463,8 @@ void run(bt::MultiObjectTracker& tracker, const bt::io::RgbdSequence& sequence, 
           problems[k] = missing.what();
         }
       }
-      data.raw.mask = cv::Mat();
-      const cv::Rect region = tracker.regionOfInterest(data.raw.color.size(), given);
-      frame = sequence.preprocess(std::move(data.raw), region);
+      const cv::Rect region = tracker.regionOfInterest(data.frame.raw.color.size(), given);
+      frame = bt::io::preprocessedOver(std::move(data.frame), region, preprocess);
     } catch (const bt::InputError& error) {
       if (i == 0 || options.strict) throw;
       frame_problem = error.what();

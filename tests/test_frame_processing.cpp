@@ -12,6 +12,7 @@
 #include "bundletrack/core/rgbd_frame.hpp"
 #include "bundletrack/core/se3.hpp"
 #include "bundletrack/core/surface_grid.hpp"
+#include "bundletrack/io/frame_ahead.hpp"
 
 namespace bt = bundletrack;
 
@@ -206,6 +207,43 @@ TEST_CASE("a frame preprocessed inside a region equals the whole image's preproc
       CHECK(cv::norm(from_part.normals, from_whole.normals, cv::NORM_INF) == 0.0);
     }
   }
+}
+
+TEST_CASE("a frame preprocessed ahead is used where the tracker asks for its region, and made again elsewhere") {
+  const cv::Size size(128, 96);
+  const cv::Mat depth = planeDepth(Eigen::Vector3f(0.1f, 0.2f, -1.0f).normalized(), -0.9f, size);
+  const cv::Mat color(size, CV_8UC3, cv::Scalar::all(128));
+  cv::Mat mask = cv::Mat::zeros(size, CV_8UC1);
+  mask(cv::Rect(50, 30, 20, 25)).setTo(255);
+  const cv::Rect foretold = bt::maskRegion(mask, size);
+  CHECK(foretold == cv::Rect(50 - bt::kRegionMargin, 30 - bt::kRegionMargin, 20 + 2 * bt::kRegionMargin,
+                             25 + 2 * bt::kRegionMargin));
+  int made = 0;
+  const auto preprocess = [&](bt::RawFrame raw, const cv::Rect& region) {
+    ++made;
+    return bt::makeFrame(std::move(raw), kCamera, {}, region);
+  };
+  const bt::RawFrame raw{"0", color, depth, mask};
+  for (const cv::Rect asked : {foretold, cv::Rect(), cv::Rect(10, 10, 40, 40)}) {
+    CAPTURE(asked);
+    made = 0;
+    bt::io::FrameAhead ahead = bt::io::frameAhead(raw, foretold, preprocess);
+    const float* made_ahead = ahead.preprocessed->depth.ptr<float>();
+    const bt::RgbdFrame frame = bt::io::preprocessedOver(std::move(ahead), asked, preprocess);
+    const bt::RgbdFrame reference = bt::makeFrame(raw, kCamera, {}, asked);
+    const bool same_region = asked == foretold;
+    CHECK(made == (same_region ? 1 : 2));
+    CHECK((frame.depth.ptr<float>() == made_ahead) == same_region);
+    CHECK(frame.region == reference.region);
+    CHECK(cv::norm(frame.depth, reference.depth, cv::NORM_INF) == 0.0);
+    CHECK(cv::norm(frame.normals, reference.normals, cv::NORM_INF) == 0.0);
+    CHECK(cv::countNonZero(frame.mask != mask) == 0);
+  }
+  // Nothing foretold (masks propagated by the tracker): the frame is made when asked for.
+  made = 0;
+  const bt::RgbdFrame frame = bt::io::preprocessedOver(bt::io::frameAhead(raw, std::nullopt, preprocess), foretold, preprocess);
+  CHECK(made == 1);
+  CHECK(frame.region == foretold);
 }
 
 TEST_CASE("the intensity image drops shading and the background and holds each grid cell's intensity") {

@@ -21,4 +21,10 @@ inline cv::Rect maskBoxOrWhole(const cv::Mat& mask, cv::Size image) {
   return box.area() > 0 ? box : cv::Rect({0, 0}, image);
 }
 
+/// The part of a frame a tracker with given masks reads when given `mask`: its box grown by
+/// kRegionMargin (the whole image for an empty mask).
+inline cv::Rect maskRegion(const cv::Mat& mask, cv::Size image) {
+  return grownWithin(maskBoxOrWhole(mask, image), kRegionMargin, image);
+}
+
 }  // namespace bundletrack

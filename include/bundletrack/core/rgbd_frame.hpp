@@ -46,6 +46,13 @@ inline int preprocessingReach(const FrameSettings& s) {
   return s.depth_filter.erode_radius + s.depth_filter.smooth_passes * s.depth_filter.smooth_radius + 1;
 }
 
+/// The part of an image of size `image` that makeFrame preprocesses for `region`: the region
+/// within the image, or the whole image for an empty region.
+inline cv::Rect preprocessedRegion(const cv::Rect& region, cv::Size image) {
+  const cv::Rect whole({0, 0}, image);
+  return region.area() > 0 ? region & whole : whole;
+}
+
 /// Filters the raw depth (metres) and derives points and normals, the depth tolerances widened by
 /// the sensor's noise. With a region (Tracker::regionOfInterest: the object's neighbourhood), only
 /// that part of the image is processed, from the raw depth within preprocessingReach of it, so the
@@ -53,7 +60,7 @@ inline int preprocessingReach(const FrameSettings& s) {
 inline RgbdFrame makeFrame(std::string name, cv::Mat color, const cv::Mat& raw_depth, cv::Mat mask,
                            const PinholeCameraf& camera, const FrameSettings& settings = {}, cv::Rect region = {}) {
   const cv::Rect image({0, 0}, raw_depth.size());
-  region = region.area() > 0 ? region & image : image;
+  region = preprocessedRegion(region, image.size());
   const NoiseScale noise(settings.sensor, camera.fx);
   RgbdFrame frame{std::move(name), std::move(color), {}, std::move(mask), {}, {}, noise, region};
   const cv::Rect around = grownWithin(region, preprocessingReach(settings), image.size());

@@ -45,9 +45,7 @@ class CoarseTracker {
   }
 
   /// The part of the next frame to preprocess: the box of its mask, grown by kRegionMargin.
-  cv::Rect regionOfInterest(cv::Size image, const cv::Mat& given_mask) const {
-    return grownWithin(maskBoxOrWhole(given_mask, image), kRegionMargin, image);
-  }
+  cv::Rect regionOfInterest(cv::Size image, const cv::Mat& given_mask) const { return maskRegion(given_mask, image); }
 
   TrackResult track(const RgbdFrame& frame) {
     if (!reference_) throw InputError("frame " + frame.name, "track() called before initialize()");
