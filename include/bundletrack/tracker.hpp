@@ -276,6 +276,12 @@ class Tracker {
     coarse.T_cam_obj = coarse.found ? from_last.T_second_first * last.T_cam_obj : last_->T_cam_obj;
     if (coarse.found) coarse.last_inliers = std::move(from_last.inliers);
     ctx.candidates.push_back(std::move(coarse));
+    // A registration on fewer inliers than chance can gather may be wrong (a small mug 3 m away:
+    // 8 of 8 matches kept, turned by 140 degrees): where the keyframes' surfaces refuse the graph
+    // from it, the graph from the last good pose is tried on the surface's evidence before
+    // RANSAC's pose is reported.
+    if (ctx.candidates.back().found && ctx.result.inliers < settings_.recovery_min_inliers)
+      ctx.candidates.push_back({last_->T_cam_obj, false, false, Evidence::SurfaceOnly, {}});
     return true;
   }
 
@@ -352,9 +358,10 @@ class Tracker {
   }
 
   /// Paper IV-C to IV-E's checks on each coarse pose in turn (segment under it, build and optimise
-  /// the graph, verify); the first accepted result is the frame's. After lost frames the
-  /// candidates with the surface alone behind them are all optimised and decided together
-  /// (TrackerSettings::recovery_min_consensus).
+  /// the graph, verify); the first accepted result is the frame's, and where none is, RANSAC's
+  /// pose (the first candidate's, CoarseOnly) unless the track is being re-acquired. After lost
+  /// frames the candidates with the surface alone behind them are all optimised and decided
+  /// together (TrackerSettings::recovery_min_consensus).
   bool refineCoarsePose(FrameContext& ctx) {
     const bool several = ctx.recovering || ctx.candidates.size() > 1;  // tries that need the features again
     const FrameFeatures detected = several ? ctx.features : FrameFeatures();
@@ -362,10 +369,13 @@ class Tracker {
     std::vector<SE3d> reached;  // by surface-only candidates the verifier's min_agreement admits ...
     std::vector<std::size_t> reached_from;  // ... and from which
     std::optional<std::size_t> first_confirmed;  // the first that passes the SurfaceOnly test
+    bool first_placed = false;  // the first candidate's mask is not empty
     for (std::size_t k = 0; k < ctx.candidates.size(); ++k) {
-      if (!optimiseFrom(ctx, ctx.candidates[k], features)) continue;
+      const bool placed = optimiseFrom(ctx, ctx.candidates[k], features);
+      if (k == 0) first_placed = placed;
+      if (!placed) continue;
       if (!ctx.recovering || ctx.coarse.evidence != Evidence::SurfaceOnly) {
-        if (acceptPose(ctx)) return true;
+        if (takeGraphPose(ctx)) return true;
         continue;
       }
       if (verifier_.accepts(ctx.graph, Evidence::SurfaceConsensus)) {
@@ -373,6 +383,10 @@ class Tracker {
         reached_from.push_back(k);
       }
       if (!first_confirmed && verifier_.accepts(ctx.graph, Evidence::SurfaceOnly)) first_confirmed = k;
+    }
+    if (!ctx.recovering) {  // RANSAC's pose, the first candidate's, where every graph was refused
+      const bool placed = ctx.candidates.size() == 1 ? first_placed : placeAt(ctx, ctx.candidates.front(), features);
+      return placed && takeCoarsePose(ctx);
     }
     const double distance =
         reached.empty() ? 0.0 : ctx.frame.noise.widen(settings_.recovery_consensus_distance, float(reached[0].translation().z()));
@@ -393,13 +407,19 @@ class Tracker {
   /// The graph of the current frame from one coarse pose (false: the object is not where it says),
   /// with the frame's `features` when given (else those in ctx, which move into the node).
   bool optimiseFrom(FrameContext& ctx, const CoarseEstimate& coarse, const FrameFeatures* features) {
+    if (!placeAt(ctx, coarse, features)) return false;
+    buildGraph(ctx);
+    optimiseGraph(ctx);
+    return true;
+  }
+
+  /// The current frame as a node at a coarse pose (segmented under it), before the graph.
+  bool placeAt(FrameContext& ctx, const CoarseEstimate& coarse, const FrameFeatures* features) {
     if (features) ctx.features = *features;
     ctx.coarse = coarse;
     if (!segmentObject(ctx)) return false;
     ctx.coarse_evidence = ctx.coarse.last_inliers;  // buildGraph may move them into an edge
     makeNode(ctx);
-    buildGraph(ctx);
-    optimiseGraph(ctx);
     return true;
   }
 
@@ -491,18 +511,25 @@ class Tracker {
     return kept >= settings_.min_kept_coarse_inliers * double(inliers.size());
   }
 
+  /// The graph's result when the verifier trusts it and it keeps its coarse evidence, else the
+  /// coarse pose, unless there is none or the track is being re-acquired.
+  bool acceptPose(FrameContext& ctx) { return takeGraphPose(ctx) || takeCoarsePose(ctx); }
+
   /// The graph's result when the verifier trusts it and it keeps its coarse evidence (the keyframes
-  /// take their optimised poses too), else the coarse pose, unless there is none or the track is
-  /// being re-acquired.
-  bool acceptPose(FrameContext& ctx) {
-    if (verifier_.accepts(ctx.graph, ctx.coarse.evidence) && keepsCoarseEvidence(ctx)) {
-      for (std::size_t n = 0; n < ctx.graph.pool_indices.size(); ++n)
-        pool_[ctx.graph.pool_indices[n]].T_cam_obj = ctx.graph.poses[n];
-      ctx.result.T_cam_obj = ctx.graph.poses.back();
-      ctx.result.status = TrackStatus::Tracked;
-      ctx.result.stability = stabilityOf(ctx);
-      return true;
-    }
+  /// take their optimised poses too).
+  bool takeGraphPose(FrameContext& ctx) {
+    if (!verifier_.accepts(ctx.graph, ctx.coarse.evidence) || !keepsCoarseEvidence(ctx)) return false;
+    for (std::size_t n = 0; n < ctx.graph.pool_indices.size(); ++n)
+      pool_[ctx.graph.pool_indices[n]].T_cam_obj = ctx.graph.poses[n];
+    ctx.result.T_cam_obj = ctx.graph.poses.back();
+    ctx.result.status = TrackStatus::Tracked;
+    ctx.result.stability = stabilityOf(ctx);
+    return true;
+  }
+
+  /// The coarse pose RANSAC found, as the frame's (CoarseOnly), where the graph's is not trusted;
+  /// none where RANSAC found none or the track is being re-acquired.
+  bool takeCoarsePose(FrameContext& ctx) {
     if (!ctx.coarse.found || ctx.recovering) return false;
     ctx.result.T_cam_obj = ctx.coarse.T_cam_obj;
     ctx.result.status = TrackStatus::CoarseOnly;

@@ -197,7 +197,7 @@ inline std::vector<ConfigEntry> configEntries(Config& c) {
       {"graph", "min_agreement", &c.verification.min_agreement, 0.0, 1.0, "", "fraction of overlapping points on a keyframe's surface to accept the graph's pose"},
       {"graph", "agreement_distance", &c.verification.gate.max_distance, 0.0, 1.0, "m", "on the surface: within this distance"},
       {"graph", "agreement_normal_angle_deg", &c.verification.gate.max_normal_angle_deg, 0.0, 180.0, "deg", "on the surface: normals within this angle"},
-      {"graph", "recovery_min_inliers", &t.recovery_min_inliers, 3, 100000, "", "RANSAC inliers needed to restart after lost frames"},
+      {"graph", "recovery_min_inliers", &t.recovery_min_inliers, 3, 100000, "", "RANSAC inliers needed to restart after lost frames; with fewer, a frame whose graph from RANSAC's pose is refused tries the graph from the last good pose (surface evidence) before RANSAC's pose stands"},
       {"graph", "min_kept_coarse_inliers", &t.min_kept_coarse_inliers, 0.0, 1.0, "", "a graph result must keep this share of the coarse pose's RANSAC inliers with the last frame (with recovery_min_inliers or more; 0: no check)"},
       {"graph", "recovery_surface_candidates", &t.recovery_surface_candidates, 0, 100, "", "coarse poses a lost frame tries with its surface alone to confirm them (0: features alone)"},
       {"graph", "recovery_min_agreement", &c.verification.recovery_min_agreement, 0.0, 1.0, "", "agreement such a re-acquisition needs"},

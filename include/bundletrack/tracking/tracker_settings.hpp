@@ -42,7 +42,9 @@ struct TrackerSettings {
   int min_edge_correspondences = 6;  ///< an edge with fewer feature correspondences has no feature term
   /// RANSAC inliers needed to restart after lost frames (with the last good frame or a keyframe).
   /// Without a motion prior a handful of inliers can be chance: on the synthetic box, 5 of 12
-  /// matches gave a pose 172 degrees off; 12 is well above what random matches gather.
+  /// matches gave a pose 172 degrees off; 12 is well above what random matches gather. Below it,
+  /// a frame whose graph from RANSAC's pose the verifier refuses also tries the graph from the
+  /// last good pose on the surface's evidence before it falls back on RANSAC's pose.
   int recovery_min_inliers = 12;
   /// A graph result must keep this share of the coarse pose's RANSAC inliers with the last good
   /// frame within edge_gate, where there are recovery_min_inliers or more (Tracker's
