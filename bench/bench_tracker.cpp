@@ -91,10 +91,11 @@ auto preprocessor(const bt::PinholeCameraf& camera) {
   return [camera](bt::RawFrame raw, const cv::Rect& region) { return bt::makeFrame(std::move(raw), camera, {}, region); };
 }
 
-/// On the reading thread: the frame, preprocessed over its mask's region where it has a mask.
-bt::io::FrameAhead ahead(bt::RawFrame raw, const bt::PinholeCameraf& camera) {
+/// On the reading thread: the frame, preprocessed over its mask's region where it has a mask and
+/// tracking is behind reading (ReadAhead's backlog), as bundletrack_track does.
+bt::io::FrameAhead ahead(bt::RawFrame raw, const bt::PinholeCameraf& camera, bool backlog) {
   const std::optional<cv::Rect> foretold =
-      raw.mask.empty() ? std::nullopt : std::optional(bt::maskRegion(raw.mask, raw.color.size()));
+      !backlog || raw.mask.empty() ? std::nullopt : std::optional(bt::maskRegion(raw.mask, raw.color.size()));
   return bt::io::frameAhead(std::move(raw), foretold, preprocessor(camera));
 }
 
@@ -219,9 +220,9 @@ int main(int argc, char** argv) {
       const bt::synth::SyntheticScene scene(settings);
       const auto camera = settings.camera.cast<float>();
       run("synthetic hand-held box (rendering counted as reading)", camera, std::size_t(frames), options,
-          [&](std::size_t i) {
+          [&](std::size_t i, bool backlog) {
             const auto f = scene.frame(int(i));
-            return Input{ahead({std::to_string(i), f.color, f.depth, f.mask}, camera), f.T_cam_obj};
+            return Input{ahead({std::to_string(i), f.color, f.depth, f.mask}, camera, backlog), f.T_cam_obj};
           });
     }
     for (const auto& dir : options.sequences) {
@@ -230,8 +231,8 @@ int main(int argc, char** argv) {
       const double decode_ms = decodeOnlyMs(sequence, sequence.size());
       run(
           dir, camera, sequence.size(), options,
-          [&](std::size_t i) {
-            return Input{ahead(sequence.read(i), camera),
+          [&](std::size_t i, bool backlog) {
+            return Input{ahead(sequence.read(i), camera, backlog),
                          sequence.hasGroundTruth() ? sequence.groundTruthPose(i) : bt::SE3d()};
           },
           decode_ms);

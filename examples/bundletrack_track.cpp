@@ -409,11 +409,12 @@ void run(bt::MultiObjectTracker& tracker, const bt::io::RgbdSequence& sequence, 
   int tracked_after_first = 0;
   // Files are decoded a few frames ahead on another thread; each frame is preprocessed once, only
   // where the trackers will look (MultiObjectTracker::regionOfInterest). With given masks that
-  // region is foretold by the frame's masks (the union of their maskRegion): the reading thread
-  // preprocesses it too, and the frame is preprocessed again only where the trackers ask for
-  // another region (a tracker's first frame: the whole image).
+  // region is foretold by the frame's masks (the union of their maskRegion): where tracking is
+  // behind reading (ReadAhead's backlog), the reading thread preprocesses it too, and the frame
+  // is preprocessed again only where the trackers ask for another region (a tracker's first
+  // frame: the whole image).
   const auto preprocess = [&](bt::RawFrame raw, const cv::Rect& region) { return sequence.preprocess(std::move(raw), region); };
-  bt::io::ReadAhead<FrameData> files(sequence.size(), [&](std::size_t i) {
+  bt::io::ReadAhead<FrameData> files(sequence.size(), [&](std::size_t i, bool backlog) {
     bt::RawFrame raw = sequence.read(i);
     FrameData data;
     if (several) {
@@ -428,7 +429,7 @@ void run(bt::MultiObjectTracker& tracker, const bt::io::RgbdSequence& sequence, 
     raw.mask = cv::Mat();  // the trackers get their masks beside the frame
     std::optional<cv::Rect> foretold;
     for (const std::optional<cv::Mat>& mask : data.masks) {
-      if (propagated || !mask || cv::countNonZero(*mask) == 0) continue;
+      if (!backlog || propagated || !mask || cv::countNonZero(*mask) == 0) continue;
       const cv::Rect own = bt::maskRegion(*mask, raw.color.size());
       foretold = foretold ? *foretold | own : own;
     }

@@ -16,10 +16,14 @@ namespace bundletrack::io {
 /// consumer, so that decoding the next frames overlaps tracking this one (the tracker's own API
 /// stays synchronous). next() hands them out in order; an item whose reading threw rethrows
 /// there, in the consumer's thread, and reading goes on with the next index.
+/// `read(i, backlog)` reads item i; `backlog` says whether, as it starts, the consumer has an
+/// item waiting already: then it will not wait for this one soon, and the reader may do more of
+/// the consumer's work on it (preprocess a frame, io::frameAhead); without, the consumer is
+/// waiting for the reader, and that work is better left to the consumer.
 template <typename T>
 class ReadAhead {
  public:
-  ReadAhead(std::size_t count, std::function<T(std::size_t)> read, std::size_t capacity = 4)
+  ReadAhead(std::size_t count, std::function<T(std::size_t, bool)> read, std::size_t capacity = 4)
       : count_(count), capacity_(capacity < 1 ? 1 : capacity), read_(std::move(read)),
         worker_([this](std::stop_token stop) { run(stop); }) {}
 
@@ -51,14 +55,16 @@ class ReadAhead {
 
   void run(const std::stop_token& stop) {
     for (std::size_t i = 0; i < count_; ++i) {
+      bool backlog = false;
       {
         std::unique_lock lock(mutex_);
         changed_.wait(lock, [&] { return stop.stop_requested() || ready_.size() < capacity_; });
         if (stop.stop_requested()) return;
+        backlog = !ready_.empty();
       }
       Slot slot = [&]() -> Slot {
         try {
-          return read_(i);
+          return read_(i, backlog);
         } catch (...) {
           return std::current_exception();
         }
@@ -72,7 +78,7 @@ class ReadAhead {
   }
 
   std::size_t count_, capacity_;
-  std::function<T(std::size_t)> read_;
+  std::function<T(std::size_t, bool)> read_;
   std::mutex mutex_;
   std::condition_variable changed_;
   std::deque<Slot> ready_;
