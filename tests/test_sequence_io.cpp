@@ -2,8 +2,12 @@
 // real sequences when they are present.
 #include <doctest/doctest.h>
 
+#include <atomic>
 #include <fstream>
+#include <thread>
+#include <vector>
 
+#include "bundletrack/io/read_ahead.hpp"
 #include "bundletrack/io/rgbd_sequence.hpp"
 #include "shared_data.hpp"
 #include "temp_dir.hpp"
@@ -229,6 +233,30 @@ TEST_CASE("bad input raises InputError naming the file and the problem") {
   SUBCASE("model file with a malformed line") {
     writeText(root / "model" / "points.xyz", "0 0 0\n0.1 x 0\n");
     checkInputError([&] { open().modelPoints(); }, root / "model" / "points.xyz", "line 2");
+  }
+}
+
+TEST_CASE("read-ahead hands items over in order and tells the reader whether the consumer has one waiting") {
+  // Capacity 1: the reader starts an item only when the consumer has taken the one before, so it
+  // never has a backlog. Capacity 4 and a consumer that takes nothing until four items are read:
+  // the first is read with nothing waiting, the next three with one or more waiting.
+  for (const std::size_t capacity : {std::size_t(1), std::size_t(4)}) {
+    CAPTURE(capacity);
+    std::vector<int> backlogs(6, -1);
+    std::atomic<int> read{0};
+    bt::io::ReadAhead<int> items(
+        6,
+        [&](std::size_t i, bool backlog) {
+          backlogs[i] = backlog ? 1 : 0;
+          ++read;
+          return int(i) * 10;
+        },
+        capacity);
+    if (capacity == 4)
+      while (read.load() < 4) std::this_thread::yield();
+    for (int i = 0; i < 6; ++i) CHECK(items.next() == 10 * i);
+    if (capacity == 1) CHECK(backlogs == std::vector<int>{0, 0, 0, 0, 0, 0});
+    else CHECK(std::vector<int>(backlogs.begin(), backlogs.begin() + 4) == std::vector<int>{0, 1, 1, 1});
   }
 }
 
