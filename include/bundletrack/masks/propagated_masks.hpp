@@ -45,12 +45,16 @@ struct PropagatedMaskSettings {
 /// the mask, which then grows over depth-continuous pixels up to growth_px beyond the rendered
 /// silhouette, never leaving the first view's hull (FirstViewHull). A mask that comes out empty
 /// means the object is not where the pose says: the tracker reports the frame lost.
-/// Such a mask is the tracker's own guess grown beyond the silhouette it predicts, not the
-/// object's outline: it has no kOutlinesObject, and the silhouette term does not read it (on the
-/// shared mug_1 it pulled the pose to its own prediction: ADD-S 93.0 -> 85.1).
+/// Where the object stands out from what lies behind it, the mask's outline is that depth edge,
+/// the data's and not the pose's, so the silhouette term reads it (kOutlinesObject); elsewhere
+/// the mask ends where the growth or the hull stops it, on a surface continuous with the object,
+/// and there the term counts nothing: it weighs a point outside a mask only where that frame saw
+/// past it (DenseSilhouette). Without it a textureless chair 3 m away slid along its seat and
+/// back by up to 5.6 cm (docs/DESIGN.md, "Whose masks").
 class PropagatedMasks {
  public:
   using Settings = PropagatedMaskSettings;
+  static constexpr bool kOutlinesObject = true;
 
   explicit PropagatedMasks(Settings settings = {}) : settings_(settings) {}
 

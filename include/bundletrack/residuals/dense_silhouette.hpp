@@ -25,9 +25,10 @@ namespace bundletrack {
 /// leaves out (a hand, a support it stands on or in), one within the noise of the point the
 /// object itself where t's mask misses it (a segmentation's rim, a mask moved by the depth-to-colour
 /// registration); without a reading nothing says the object is not there (a depth camera's
-/// narrower view, a shadow); nor does a point that lands outside t's silhouette image count. Both directions of an edge are summed. The masks must be
-/// the object's outline from the data (GivenMasks::kOutlinesObject): the tracker makes no
-/// silhouettes from masks it propagates itself.
+/// narrower view, a shadow); nor does a point that lands outside t's silhouette image count.
+/// Both directions of an edge are summed. The masks must end at the object's outline where they
+/// end before a farther surface (kOutlinesObject: given masks, and propagated ones, which end
+/// there at the depth edge).
 /// What it holds: the outline pins the motion that the surface lets slide -- a box seen on two
 /// faces slides along their common edge, a plane in its own plane -- where there is no texture.
 /// Weighting (maximum likelihood beside the point-to-plane term, as the photometric term): each
