@@ -1,15 +1,20 @@
 // geometricStability against surfaces whose free motions are known: a plane slides and spins in
 // itself, a sphere turns about its centre, a cylinder twists about and slides along its axis;
 // three faces of a box hold every direction. Independent of where the surface sits, and the
-// normal averaging removes most of what noisy normals add to a plane.
+// normal averaging removes most of what noisy normals add to a plane. And surface agreement, the
+// pose verifier, on a box's corner seen from two sides.
 #include <doctest/doctest.h>
 
 #include <cmath>
 #include <functional>
+#include <limits>
 #include <random>
 
 #include "bundletrack/core/se3.hpp"
+#include "bundletrack/graph/keyframe.hpp"
+#include "bundletrack/graph/pose_graph.hpp"
 #include "bundletrack/verification/geometric_stability.hpp"
+#include "bundletrack/verification/surface_agreement.hpp"
 
 namespace bt = bundletrack;
 
@@ -134,4 +139,68 @@ TEST_CASE("pose stability: the pose graph's information about the object's origi
     if (expected > 0.1) CHECK(bt::evenness(information) < 0.5 * expected);
   }
   CHECK(bt::poseStability(Eigen::Matrix<double, 6, 6>::Zero(), Eigen::Vector3d::Zero(), 0.1) == 0.0);
+}
+
+namespace {
+
+/// What a camera at `T_world_cam` sees of a box's corner on a 100 x 100 grid (f = 100 px): its
+/// front face (z = 1, normal -z) and its right side face (x = 0.1, normal +x, 1 <= z <= 1.2),
+/// both 0.2 m tall; camera-frame points and normals, the nearest face where a ray meets both.
+bt::SurfaceGrid viewOfBoxCorner(const bt::SE3d& T_world_cam, double noise_scale) {
+  bt::SurfaceGrid grid;
+  grid.camera = {100.0f, 100.0f, 49.5f, 49.5f};
+  grid.noise_scale = noise_scale;
+  grid.points = cv::Mat::zeros(100, 100, CV_32FC3);
+  grid.normals = cv::Mat::zeros(100, 100, CV_32FC3);
+  const bt::SE3d T_cam_world = T_world_cam.inverse();
+  const Eigen::Vector3d origin = T_world_cam.translation();
+  for (int y = 0; y < 100; ++y) {
+    for (int x = 0; x < 100; ++x) {
+      const Eigen::Vector3d ray = T_world_cam.rotation() * Eigen::Vector3d((x - 49.5) / 100.0, (y - 49.5) / 100.0, 1.0);
+      double nearest = std::numeric_limits<double>::infinity();
+      Eigen::Vector3d normal = Eigen::Vector3d::Zero();
+      const auto hit = [&](int axis, double plane, const Eigen::Vector3d& n, auto&& on_face) {
+        const double t = (plane - origin[axis]) / ray[axis];
+        const Eigen::Vector3d p = origin + t * ray;
+        if (t > 0.0 && t < nearest && on_face(p) && n.dot(ray) < 0.0) nearest = t, normal = n;
+      };
+      hit(2, 1.0, {0, 0, -1}, [](const Eigen::Vector3d& p) { return std::abs(p.x()) <= 0.1 && std::abs(p.y()) <= 0.1; });
+      hit(0, 0.1, {1, 0, 0}, [](const Eigen::Vector3d& p) { return p.z() >= 1.0 && p.z() <= 1.2 && std::abs(p.y()) <= 0.1; });
+      if (!std::isfinite(nearest)) continue;
+      const Eigen::Vector3d p = T_cam_world * (origin + nearest * ray), n = T_cam_world.rotation() * normal;
+      grid.points.at<cv::Vec3f>(y, x) = cv::Vec3f(float(p.x()), float(p.y()), float(p.z()));
+      grid.normals.at<cv::Vec3f>(y, x) = cv::Vec3f(float(n.x()), float(n.y()), float(n.z()));
+    }
+  }
+  bt::indexCells(grid);
+  return grid;
+}
+
+}  // namespace
+
+TEST_CASE("surface agreement compares a point only with the views that could have seen it") {
+  // A keyframe straight in front of a box's corner sees its front face only; the current view, 45
+  // degrees to the right, sees the side face too. Under the true poses the side face's points
+  // fall onto the keyframe's front face within the gate where it is widened for far, noisy
+  // readings (x5: 5 cm), at right angles to it: faces the keyframe's camera could not have seen,
+  // so they are not compared, and the right pose agrees fully. A pose turned by 180 degrees shows
+  // the keyframe the backs of the faces: nothing is compared, and it is refused.
+  const bt::SE3d keyframe_camera;  // the world frame: the object's
+  const bt::SE3d current_camera(bt::SO3d::exp(Eigen::Vector3d(0, -M_PI / 4, 0)), Eigen::Vector3d(0.75, 0.0, 0.25));
+  bt::Keyframe keyframe, current;
+  keyframe.surface = viewOfBoxCorner(keyframe_camera, 5.0);
+  current.surface = viewOfBoxCorner(current_camera, 5.0);
+  int side_face = 0;
+  for (const cv::Point& cell : current.surface.cells) side_face += current.surface.normal(cell)[0] < -0.5f;  // +x seen turned
+  REQUIRE(side_face > 0);
+  REQUIRE(4 * (int(current.surface.cells.size()) - side_face) >= int(current.surface.cells.size()));  // the front face lands: compared
+  bt::PoseGraph graph;
+  graph.nodes = {&keyframe, &current};
+  graph.poses = {keyframe_camera.inverse(), current_camera.inverse()};  // T_cam_obj
+  const bt::SurfaceAgreement verifier;
+  CHECK(verifier.agreement(graph) == doctest::Approx(1.0));
+  CHECK(verifier.accepts(graph, bt::Evidence::SurfaceOnly));
+  graph.poses.back() = bt::SE3d(bt::SO3d::exp(Eigen::Vector3d(0, M_PI, 0)), Eigen::Vector3d(0, 0, 2.2)) * graph.poses.back();
+  CHECK(verifier.agreement(graph) == 0.0);
+  CHECK_FALSE(verifier.accepts(graph, bt::Evidence::Features));
 }
