@@ -182,8 +182,8 @@ TEST_CASE("surface agreement compares a point only with the views that could hav
   // A keyframe straight in front of a box's corner sees its front face only; the current view, 45
   // degrees to the right, sees the side face too. Under the true poses the side face's points
   // fall onto the keyframe's front face within the gate where it is widened for far, noisy
-  // readings (x5: 5 cm), at right angles to it: faces the keyframe's camera could not have seen,
-  // so they are not compared, and the right pose agrees fully. A pose turned by 180 degrees shows
+  // readings (x5: 5 cm), at right angles to it, behind it: a face the keyframe's camera could not
+  // have seen, so it is not compared, and the right pose agrees fully. A pose turned by 180 degrees shows
   // the keyframe the backs of the faces: nothing is compared, and it is refused.
   const bt::SE3d keyframe_camera;  // the world frame: the object's
   const bt::SE3d current_camera(bt::SO3d::exp(Eigen::Vector3d(0, -M_PI / 4, 0)), Eigen::Vector3d(0.75, 0.0, 0.25));

@@ -24,9 +24,9 @@ struct SurfaceAgreementSettings {
 /// point of another node (projective association under the optimised poses), the fraction that
 /// passes the gate, widened for the two grids' noise (NoiseScale::between). Grids have holes
 /// (depth dropouts, undefined normals), so points landing in a hole say nothing, nor do points
-/// whose normal faces away from that node's camera (a face it could not have seen, which the
-/// widened gate of far readings would otherwise set against the face it did see); when fewer than
-/// a quarter of the points land anywhere the agreement is 0.
+/// whose normal faces away from that node's camera behind its reading there (a face it could not
+/// have seen, which the widened gate of far readings would otherwise set against the face it did
+/// see); when fewer than a quarter of the points land anywhere the agreement is 0.
 class SurfaceAgreement {
  public:
   using Settings = SurfaceAgreementSettings;
@@ -58,12 +58,14 @@ class SurfaceAgreement {
       for (std::size_t k = 0; k < T_k_c.size() && !agrees; ++k) {
         const SurfaceGrid& other = graph.nodes[k]->surface;
         const Eigen::Vector3d q = T_k_c[k] * p;
-        const Eigen::Vector3d n = T_k_c[k].rotation() * Eigen::Vector3d(nc[0], nc[1], nc[2]);
-        if (n.dot(q) > 0.0) continue;  // faces away from node k's camera: k cannot have seen it
         int u = 0, v = 0;
         if (!other.camera.pixelOf(q, u, v) || !other.inside(u, v)) continue;
         const cv::Vec3f& pk = other.point(u, v);
         if (pk[2] <= 0.0f) continue;
+        // A face turned away from k's camera and behind k's reading: k saw the object's front
+        // there, it cannot have seen this point. (In front of the reading it contradicts k.)
+        const Eigen::Vector3d n = T_k_c[k].rotation() * Eigen::Vector3d(nc[0], nc[1], nc[2]);
+        if (n.dot(q) > 0.0 && q.z() >= double(pk[2])) continue;
         landed = true;
         if ((Eigen::Vector3d(pk[0], pk[1], pk[2]) - q).squaredNorm() > bounds[k].max_squared_distance) continue;
         const cv::Vec3f& nk = other.normal(u, v);
