@@ -6,7 +6,7 @@
 # (bundletrack_eval --in-view; they differ where the object leaves the view). With --before, a
 # second build's tracker runs on the very same sequences and its columns stand beside.
 #
-# The design is sparse (47 synthetic cells, not the 144 of the full product), chosen so that each
+# The design is sparse (54 synthetic cells, not the 144 of the full product), chosen so that each
 # factor varies with the others held at their usual value:
 #   A  distance {0.5, 1, 2, 3 m} x object {mug 0.10 m, box 0.20 m, chair 0.70 m} x {textured,
 #      textureless}, structured light, normal speed (no chair at 0.5 m: it would not fit the view);
@@ -17,6 +17,10 @@
 #   E  masks that err from the object's outline by 3 px, as a segmentation's or a depth-to-colour
 #      registration's do (bundletrack_synth --mask-error): grown, shrunk and moved on the box at 1 m,
 #      grown and moved on the textureless box at 3 m, grown on the mug at 1 m.
+#   F  the method's own input, the first frame's mask alone (bundletrack_track --propagate-masks):
+#      the box at 1 m, the textureless mug at 1 m, the textureless box and chair at 3 m, the
+#      textureless chair at 2.5 m under active stereo, the box behind the occluder at 2 m, the mug
+#      at 3 m; and the shared sequences (real_*_propagated).
 #
 # Usage: bash bench/accuracy_matrix.sh BUILD_DIR OUT_DIR [--before BUILD_DIR [--before-label TEXT]]
 #        [--config FILE] [--data DIR] [--frames N] [--markdown FILE]
@@ -77,14 +81,23 @@ for e in dilate shift; do
   cells+=("E_box_3m_textureless_mask_${e}3|--shape box --size 0.20 --distance 3 --textureless --mask-error $e --mask-error-px 3")
 done
 cells+=("E_mug_1m_mask_dilate3|--shape mug --size 0.10 --distance 1 --mask-error dilate --mask-error-px 3")
+for cell in "box_1m|--shape box --size 0.20 --distance 1" "mug_1m_textureless|--shape mug --size 0.10 --distance 1 --textureless" \
+  "box_3m_textureless|--shape box --size 0.20 --distance 3 --textureless" \
+  "chair_3m_textureless|--shape chair --size 0.70 --distance 3 --textureless" \
+  "chair_2.5m_textureless_active_stereo|--shape chair --size 0.70 --distance 2.5 --textureless --sensor active_stereo" \
+  "box_2m_occluder|--shape box --size 0.20 --distance 2 --occluder" "mug_3m|--shape mug --size 0.10 --distance 3"; do
+  cells+=("F_${cell%%|*}_propagated|${cell#*|}|--propagate-masks")
+done
 
 tool() {  # build name -> path of the build's executable
   if [ -x "$1/bin/$2" ]; then echo "$1/bin/$2"; else echo "$1/$2"; fi
 }
-track() {  # build sequence target [reuse [config]] -> csv fields
+track() {  # build sequence target [reuse [config [tracker options]]] -> csv fields
   local bin seq=$2 target=$3 reuse=${4:-} settings=()
   bin=$(tool "$1" bundletrack_track)
   [ -n "${5:-}" ] && settings=(--config "$5")
+  # shellcheck disable=SC2206
+  [ -n "${6:-}" ] && settings+=($6)
   mkdir -p "$target"
   if [ -z "$reuse" ] || ! grep -q "^sequence" "$target.log" 2> /dev/null; then
     "$bin" --sequence "$seq" --out "$target" --quiet "${settings[@]}" > "$target.log" 2>&1 || { echo "n/a,n/a,n/a,n/a,n/a,n/a,n/a,n/a"; return; }
@@ -120,10 +133,11 @@ echo "cell,options,$run_columns,before_${run_columns//,/,before_}" > "$csv_file"
 mug_csv="$out/mug_rotation.csv"
 mug_columns="visible_frames,R_err_visible_deg,hidden_frames,R_err_hidden_deg,again_frames,R_err_again_deg"
 echo "cell,$mug_columns,before_${mug_columns//,/,before_}" > "$mug_csv"
-run_cell() {  # name options sequence
-  local name=$1 options=$2 seq=$3 after before_fields=",,,,,,," mug_before=",,,,,"
-  after=$(track "$build" "$seq" "$out/runs/after/$name" "" "$config")
-  [ -n "$before" ] && before_fields=$(track "$before" "$seq" "$out/runs/before/$name" reuse)
+run_cell() {  # name options sequence [tracker options]
+  local name=$1 options=$2 seq=$3 tracking=${4:-} after before_fields=",,,,,,," mug_before=",,,,,"
+  after=$(track "$build" "$seq" "$out/runs/after/$name" "" "$config" "$tracking")
+  [ -n "$before" ] && before_fields=$(track "$before" "$seq" "$out/runs/before/$name" reuse "" "$tracking")
+  [ -n "$tracking" ] && options+="; tracked with $tracking"
   echo "$name,\"$options\",$after,$before_fields" >> "$csv_file"
   echo "$name: $after | before: $before_fields"
   if [[ $name == *_mug_* && $name != real_* ]]; then
@@ -134,13 +148,18 @@ run_cell() {  # name options sequence
 for cell in "${cells[@]}"; do
   name=${cell%%|*}
   options=${cell#*|}
+  tracking=""
+  [[ $options == *"|"* ]] && tracking=${options#*|} && options=${options%%|*}
   seq="$out/sequences/$name"
   # shellcheck disable=SC2086
-  [ -d "$seq/rgb" ] || "$build/bin/bundletrack_synth" --out "$seq" --frames "$frames" $options > /dev/null
-  run_cell "$name" "$options" "$seq"
+  [ -d "$seq/rgb" ] || "$(tool "$build" bundletrack_synth)" --out "$seq" --frames "$frames" $options > /dev/null
+  run_cell "$name" "$options" "$seq" "$tracking"
 done
 for s in mug_1 magazines_1 container_1; do
   [ -d "$data/$s" ] && run_cell "real_$s" "shared sequence" "$data/$s"
+done
+for s in mug_1 magazines_1 container_1; do
+  [ -d "$data/$s" ] && run_cell "real_${s}_propagated" "shared sequence" "$data/$s" --propagate-masks
 done
 
 $py - "$csv_file" "$markdown" "$frames" "$mug_csv" "$([ -n "$before" ] && echo 1 || echo 0)" "$before_label" "$config" <<'PY'
@@ -156,8 +175,9 @@ out = ["# Accuracy stress matrix", "",
        "tracking time per frame on this machine (2 cores); in view: ADD / ADD-S over the frames in which",
        "the object is seen (`bundletrack_eval --in-view`), which differ from the whole sequence's only",
        "where the object leaves the view (D_*_out_of_view). Cell names: A distance x object x texture,",
-       "B sensor, C fast motion, D occlusion and out of view, E masks 3 px off the outline; see the",
-       "script's header for the design."]
+       "B sensor, C fast motion, D occlusion and out of view, E masks 3 px off the outline, F and",
+       "real_*_propagated: the first frame's mask alone (--propagate-masks); see the script's header",
+       "for the design."]
 if with_before:
     out.append(f"The before columns: {before_label}, on the same sequences.")
 out.append("")
