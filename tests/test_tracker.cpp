@@ -151,18 +151,24 @@ TEST_CASE("brightness keeps a small textured mug's turn at 2 m where its surface
 
 namespace {
 
+/// A textureless object of `size` metres `distance` metres away, as the stress matrix's far cells.
+synth::SyntheticSequenceSettings texturelessAt(synth::Shape shape, double size, double distance, int frames) {
+  synth::SyntheticSequenceSettings settings;
+  settings.shape = shape;
+  settings.size = size;
+  settings.distance = distance;
+  settings.textureless = true;
+  settings.frames = frames;
+  return settings;
+}
+
 /// The stress matrix's textureless 20 cm box 3 m away (60 frames), its masks off the outline by
 /// `error` (3 px), tracked by the default tracker without and with the silhouette term.
 struct OutlineRuns {
   Run surface, outline;
 };
 OutlineRuns texturelessBoxAt3m(synth::MaskError error) {
-  synth::SyntheticSequenceSettings settings;
-  settings.shape = synth::Shape::Box;
-  settings.size = 0.20;
-  settings.distance = 3.0;
-  settings.textureless = true;
-  settings.frames = 60;
+  synth::SyntheticSequenceSettings settings = texturelessAt(synth::Shape::Box, 0.20, 3.0, 60);
   settings.mask_error = error;
   settings.mask_error_px = 3;
   const synth::SyntheticScene scene(settings);
@@ -272,12 +278,7 @@ TEST_CASE("from the first mask alone: the propagated mask's outline keeps a far 
   without.silhouette_weight = 0.0;
   double with_cm = 0.0, without_cm = 0.0;
   for (const unsigned seed : kSeeds) {
-    synth::SyntheticSequenceSettings settings;
-    settings.shape = synth::Shape::Chair;
-    settings.size = 0.70;
-    settings.distance = 3.0;
-    settings.textureless = true;
-    settings.frames = 30;
+    synth::SyntheticSequenceSettings settings = texturelessAt(synth::Shape::Chair, 0.70, 3.0, 30);
     settings.seed = seed;
     const synth::SyntheticScene scene(settings);
     const auto model = scene.objectMesh().sampleSurface(1000, 1);
