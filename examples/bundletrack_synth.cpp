@@ -22,7 +22,7 @@ int main(int argc, char** argv) {
       "Renders a synthetic RGB-D sequence with exact ground truth (annotated poses, masks, model) in the\n"
       "YCBInEOAT or the TUM RGB-D layout.",
       "bundletrack_synth");
-  command_line.add_option("--out", out, "the sequence directory to write")->type_name("DIR")->required();
+  command_line.add_option("--out", out, "the sequence directory to write (a sequence already there is replaced)")->type_name("DIR")->required();
   command_line.add_option("--frames", settings.frames, "number of frames")->capture_default_str()->check(bt::examples::wholeAtLeast(1));
   command_line.add_option("--shape", shape, "box | cylinder | mug | chair (0.83 m: legs, seat and back; use with --distance)")
       ->capture_default_str()

@@ -3,6 +3,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <numeric>
 
 #include "bundletrack/io/rgbd_sequence.hpp"
@@ -324,6 +325,13 @@ TEST_CASE("a written synthetic sequence reads back with its ground truth, determ
   settings.seed = 2;
   synth::writeSyntheticSequence(dir.path() / "c", settings);
   CHECK(cv::norm(a.rawDepth(1), bt::io::RgbdSequence(dir.path() / "c").rawDepth(1), cv::NORM_INF) > 0.0);
+  // Written again, shorter, over the first: the earlier sequence's last frames are gone.
+  settings.frames = 2;
+  synth::writeSyntheticSequence(dir.path() / "a", settings);
+  const bt::io::RgbdSequence again(dir.path() / "a");
+  CHECK(again.size() == 2);
+  CHECK(std::distance(std::filesystem::directory_iterator(dir.path() / "a" / "masks"), {}) == 2);
+  CHECK(cv::norm(again.rawDepth(1), bt::io::RgbdSequence(dir.path() / "c").rawDepth(1), cv::NORM_INF) == 0.0);
 }
 
 TEST_CASE("the TUM RGB-D layout: timestamps associated, depth in 1/5000 m, the same frames as YCBInEOAT") {

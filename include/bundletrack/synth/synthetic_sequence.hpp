@@ -334,13 +334,17 @@ inline void writeFrame(const std::filesystem::path& root, const SyntheticScene& 
 /// cam_K.txt, model/points.xyz), or in the TUM RGB-D layout (the same with rgb.txt and depth.txt
 /// listing timestamped images, depth in 1/5000 m); a scene of several objects has a subfolder per
 /// object in masks/, annotated_poses/ and model/ (objectFolder), or with MaskFiles::LabelImages
-/// one label image per frame in labels/ instead of masks/. Frames are rendered in parallel; the
-/// result depends only on the settings.
+/// one label image per frame in labels/ instead of masks/. A sequence already in `root` is
+/// replaced, not mixed with the new one: those folders and lists are removed first (a reader would
+/// otherwise take an earlier, longer sequence's frames for this one's). Frames are rendered in
+/// parallel; the result depends only on the settings.
 inline void writeSyntheticSequence(const std::filesystem::path& root, const SyntheticSequenceSettings& settings,
                                    io::Layout layout = io::Layout::YcbInEoat, MaskFiles mask_files = MaskFiles::Folders) {
   const SyntheticScene scene(settings);
   if (mask_files == MaskFiles::LabelImages && scene.objectCount() == 1)
     throw InputError(root, "label images are for scenes of several objects");
+  for (const char* written : {"rgb", "depth", "masks", "labels", "annotated_poses", "model", "rgb.txt", "depth.txt"})
+    std::filesystem::remove_all(root / written);
   for (const char* dir : {"rgb", "depth"}) std::filesystem::create_directories(root / dir);
   for (int k = 0; k < scene.objectCount(); ++k)
     for (const char* dir : {"masks", "annotated_poses", "model"})
