@@ -13,6 +13,7 @@
 #include "bundletrack/masks/depth_segments.hpp"
 #include "bundletrack/masks/first_view_hull.hpp"
 #include "bundletrack/masks/mask_source.hpp"
+#include "bundletrack/masks/support_plane.hpp"
 
 namespace bundletrack {
 
@@ -38,12 +39,17 @@ struct PropagatedMaskSettings {
   /// ... showing at least this fraction of the first view's pixel area scaled to their depth (a
   /// partly hidden or edge-on view shows less; depth dropouts cut the background into crumbs).
   float min_area_fraction = 0.25f;
+  /// The mask does not grow onto the surface the object rested on or leaned against in the first
+  /// frame (SupportPlane; found there if there is one): within depth_continuity of that plane,
+  /// widened by the noise, only pixels that agree with the rendered object join.
+  bool stop_at_support = true;
 };
 
 /// Object masks from the first one alone (replacing the paper's video segmentation network): the
 /// object surfaces seen so far are rendered under the coarse pose; pixels whose depth agrees seed
 /// the mask, which then grows over depth-continuous pixels up to growth_px beyond the rendered
-/// silhouette, never leaving the first view's hull (FirstViewHull). A mask that comes out empty
+/// silhouette, never leaving the first view's hull (FirstViewHull) nor growing onto the surface
+/// the object rested on there (SupportPlane, where the legs of a chair meet the floor). A mask that comes out empty
 /// means the object is not where the pose says: the tracker reports the frame lost.
 /// Where the object stands out from what lies behind it, the mask's outline is that depth edge,
 /// the data's and not the pose's, so the silhouette term reads it (kOutlinesObject); elsewhere
@@ -64,6 +70,9 @@ class PropagatedMasks {
     camera_ = camera;
     grid_step_ = grid_step;
     hull_ = FirstViewHull(first, camera, T_cam_obj, settings_.hull_dilation_px, settings_.hull_depth_tolerance);
+    support_.reset();
+    if (settings_.stop_at_support)
+      support_ = findSupportPlane(first, T_cam_obj, settings_.depth_continuity, settings_.hull_dilation_px);
     const cv::Mat seen = first.mask & (first.depth > 0.0f);
     first_area_ = cv::countNonZero(seen);
     if (first_area_ == 0)
@@ -115,9 +124,11 @@ class PropagatedMasks {
         const float z = frame.depth.at<float>(v, u);
         if (!region.at<uchar>(v, u) || z <= 0.0f) continue;
         const cv::Vec3f& p = frame.points.at<cv::Vec3f>(v, u);
-        if (!hull_.contains(T_obj_cam * Eigen::Vector3d(p[0], p[1], p[2]))) continue;
+        const Eigen::Vector3d p_obj = T_obj_cam * Eigen::Vector3d(p[0], p[1], p[2]);
+        if (!hull_.contains(p_obj)) continue;
         const float expected = rendered.at<float>(v, u);
         const bool agrees = expected > 0.0f && std::abs(z - expected) <= frame.noise.widen(settings_.depth_agreement, z);
+        if (!agrees && support_ && support_->distance(p_obj) <= frame.noise.widen(settings_.depth_continuity, z)) continue;
         label.at<uchar>(v, u) = agrees ? kObject : kCandidate;
         if (agrees) frontier.emplace_back(u, v);
       }
@@ -213,6 +224,7 @@ class PropagatedMasks {
   PinholeCameraf camera_{};
   int grid_step_ = 1;
   FirstViewHull hull_;
+  std::optional<SupportPlane> support_;  ///< what the object rested on in the first frame, if anything
   int first_area_ = 0;  ///< pixels of the first mask with depth
   float first_depth_ = 0.0f;  ///< their mean depth
   bool started_ = false;
