@@ -10,6 +10,7 @@
 #include "bundletrack/core/error.hpp"
 #include "bundletrack/core/image_region.hpp"
 #include "bundletrack/core/surface_grid.hpp"
+#include "bundletrack/masks/colour_likelihood.hpp"
 #include "bundletrack/masks/depth_segments.hpp"
 #include "bundletrack/masks/first_view_hull.hpp"
 #include "bundletrack/masks/mask_source.hpp"
@@ -39,17 +40,19 @@ struct PropagatedMaskSettings {
   /// ... showing at least this fraction of the first view's pixel area scaled to their depth (a
   /// partly hidden or edge-on view shows less; depth dropouts cut the background into crumbs).
   float min_area_fraction = 0.25f;
-  /// The mask does not grow onto the surface the object rested on or leaned against in the first
-  /// frame (SupportPlane; found there if there is one): within depth_continuity of that plane,
-  /// widened by the noise, only pixels that agree with the rendered object join.
+  /// The mask stays off the surface the object rested on or leaned against in the first frame
+  /// (SupportPlane; found there if there is one): within depth_continuity of that plane, widened
+  /// by the noise, where depth cannot tell the object's foot from the support, a pixel joins only
+  /// if its colour is more frequent on the first mask than around it (ColourLikelihood).
   bool stop_at_support = true;
 };
 
 /// Object masks from the first one alone (replacing the paper's video segmentation network): the
 /// object surfaces seen so far are rendered under the coarse pose; pixels whose depth agrees seed
 /// the mask, which then grows over depth-continuous pixels up to growth_px beyond the rendered
-/// silhouette, never leaving the first view's hull (FirstViewHull) nor growing onto the surface
-/// the object rested on there (SupportPlane, where the legs of a chair meet the floor). A mask that comes out empty
+/// silhouette, never leaving the first view's hull (FirstViewHull) nor taking in the surface the
+/// object rested on there (SupportPlane: the floor at a chair's legs, the table at a mug's foot,
+/// told apart by colour within the plane's noise). A mask that comes out empty
 /// means the object is not where the pose says: the tracker reports the frame lost.
 /// Where the object stands out from what lies behind it, the mask's outline is that depth edge,
 /// the data's and not the pose's, so the silhouette term reads it (kOutlinesObject); elsewhere
@@ -73,6 +76,8 @@ class PropagatedMasks {
     support_.reset();
     if (settings_.stop_at_support)
       support_ = findSupportPlane(first, T_cam_obj, settings_.depth_continuity, settings_.hull_dilation_px);
+    colour_ = support_ ? ColourLikelihood(first.color, first.mask, ringAround(first.mask, settings_.hull_dilation_px))
+                       : ColourLikelihood();
     const cv::Mat seen = first.mask & (first.depth > 0.0f);
     first_area_ = cv::countNonZero(seen);
     if (first_area_ == 0)
@@ -128,7 +133,9 @@ class PropagatedMasks {
         if (!hull_.contains(p_obj)) continue;
         const float expected = rendered.at<float>(v, u);
         const bool agrees = expected > 0.0f && std::abs(z - expected) <= frame.noise.widen(settings_.depth_agreement, z);
-        if (!agrees && support_ && support_->distance(p_obj) <= frame.noise.widen(settings_.depth_continuity, z)) continue;
+        if (support_ && support_->distance(p_obj) <= frame.noise.widen(settings_.depth_continuity, z) &&
+            !colour_.objectLike(frame.color.at<cv::Vec3b>(v, u)))
+          continue;
         label.at<uchar>(v, u) = agrees ? kObject : kCandidate;
         if (agrees) frontier.emplace_back(u, v);
       }
@@ -225,6 +232,7 @@ class PropagatedMasks {
   int grid_step_ = 1;
   FirstViewHull hull_;
   std::optional<SupportPlane> support_;  ///< what the object rested on in the first frame, if anything
+  ColourLikelihood colour_;  ///< the first mask's colours against those around it, with a support plane
   int first_area_ = 0;  ///< pixels of the first mask with depth
   float first_depth_ = 0.0f;  ///< their mean depth
   bool started_ = false;

@@ -2,8 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
-#include <optional>
 #include <numbers>
+#include <optional>
 #include <random>
 #include <vector>
 
@@ -30,31 +30,38 @@ struct SupportPlane {
   double distance(const Eigen::Vector3d& p_obj) const { return normal.dot(p_obj) + offset; }
 };
 
+/// The pixels around an object's mask that findSupportPlane fits the plane to: from `gap_px` out
+/// (the mask's registration error) to half the mask's size (the square root of its area) beyond
+/// that, at least 8 pixels; empty for an empty mask.
+inline cv::Mat ringAround(const cv::Mat& mask, int gap_px) {
+  const int area = cv::countNonZero(mask);
+  if (area == 0) return cv::Mat::zeros(mask.size(), CV_8UC1);
+  const int ring_px = std::max(8, int(std::lround(0.5 * std::sqrt(double(area)))));
+  const auto dilated = [&](int r) {
+    cv::Mat out;
+    cv::dilate(mask, out, cv::getStructuringElement(cv::MORPH_ELLIPSE, {2 * r + 1, 2 * r + 1}));
+    return out;
+  };
+  return dilated(gap_px + ring_px) & ~dilated(gap_px);
+}
+
 /// Finds the support plane in the first frame, if there is one: a plane fitted by RANSAC (three
 /// points per hypothesis, a fixed seed) to the readings in a ring around the object's mask,
-/// within `tolerance` (widened by the frame's NoiseScale at each reading), that
+/// within `tolerance` (widened by the frame's NoiseScale at each reading) and with normals within
+/// 45 degrees of its own (the paper's RANSAC normal check), that
 /// - holds a quarter of the ring's readings or more (a surface around the object, not a crumb),
 /// - has at most 2 % of the object's readings more than `tolerance` behind it (the object lies on
 ///   one side), and
 /// - is reached by the object: 2 % of its readings or more lie within `tolerance` of it (it
 ///   touches the plane; an object held in front of a wall does not).
-/// The ring reaches half the mask's size (the square root of its area) beyond the mask, at least
-/// 8 pixels, and starts `gap_px` out (the mask's registration error); the mask itself must be
-/// the object's (the first frame's given mask).
+/// The best such plane (most inliers) is refitted by least squares over its inliers. The ring is
+/// ringAround(mask, gap_px); the mask must be the object's (the first frame's given mask).
 inline std::optional<SupportPlane> findSupportPlane(const RgbdFrame& first, const SE3d& T_cam_obj, float tolerance,
                                                     int gap_px) {
   constexpr double kMinRingFraction = 0.25, kMaxBehindFraction = 0.02, kMinContactFraction = 0.02;
   const float kMinNormalCosine = std::cos(float(std::numbers::pi) / 4.0f);  // RANSAC's 45 degree normal check
   constexpr int kHypotheses = 256, kMinRingPoints = 30, kMaxObjectPoints = 4000;
-  const int area = cv::countNonZero(first.mask);
-  if (area == 0) return std::nullopt;
-  const int ring_px = std::max(8, int(std::lround(0.5 * std::sqrt(double(area)))));
-  const auto dilated = [&](int r) {
-    cv::Mat out;
-    cv::dilate(first.mask, out, cv::getStructuringElement(cv::MORPH_ELLIPSE, {2 * r + 1, 2 * r + 1}));
-    return out;
-  };
-  const cv::Mat ring = dilated(gap_px + ring_px) & ~dilated(gap_px) & (first.depth > 0.0f);
+  const cv::Mat ring = ringAround(first.mask, gap_px) & (first.depth > 0.0f);
 
   struct Reading {
     Eigen::Vector3f p, n;
