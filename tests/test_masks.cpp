@@ -237,7 +237,7 @@ TEST_CASE("propagated mask: a chair's legs stand on the floor, the mask stops at
     // Without the plane the mask spreads over the floor from the legs (120-370 px, 2.5-6.5 % of
     // it); with it what remains off the chair (0-54 px) is the legs' ends and the rim's noise.
     CHECK(3 * stopped[k].first <= leaking[k].first);
-    // The legs' last centimetres near the floor join only where they agree with the render.
+    // The legs' last centimetres, within the floor's noise, join where their colour is the chair's.
     CHECK(stopped[k].second >= 0.95);
   }
 }
