@@ -236,7 +236,7 @@ inline std::vector<ConfigEntry> configEntries(Config& c) {
       {"masks", "object_size_factor", &m.object_size_factor, 0.0, 100.0, "", "propagated, after lost: searched surfaces are at most this times the first view's extent"},
       {"masks", "min_area_fraction", &m.min_area_fraction, 0.0, 1.0, "", "propagated, after lost: and show this fraction of the first view's area"},
       {"masks", "support", enumChoice(m.stop_at_support, {{"plane", true}, {"none", false}}), 0, 0, "",
-       "propagated: plane: the mask stays off the surface the object rested on in the first frame (if it rested on one; near it only pixels coloured as the first mask join); none: no such rule"},
+       "propagated: plane: the mask stays off the surface the object rested on in the first frame (if it rested on one; near it only pixels coloured as the first mask join, or only seeds where colour cannot tell); none: no such rule"},
       {"compute", "device", textChoice(c.device, {"cpu", "gpu"}), 0, 0, "",
        "cpu: header-only policies; gpu: matching, dense term, PCG and RANSAC on a CUDA device (bundletrack::cuda; keypoints are still detected on the CPU)"},
       {"compute", "execution", enumChoice(c.execution, {{"parallel", Execution::Parallel}, {"serial", Execution::Serial}}), 0, 0, "",

@@ -27,6 +27,19 @@ class ColourLikelihood {
     }
   }
 
+  /// The share of the pixels of `color` under `region` that look like the object (objectLike).
+  double objectLikeShare(const cv::Mat& color, const cv::Mat& region) const {
+    int like = 0, all = 0;
+    for (int v = 0; v < color.rows; ++v) {
+      for (int u = 0; u < color.cols; ++u) {
+        if (!region.at<uchar>(v, u)) continue;
+        ++all;
+        like += objectLike(color.at<cv::Vec3b>(v, u));
+      }
+    }
+    return all > 0 ? double(like) / all : 0.0;
+  }
+
   /// Whether `c` is at least as frequent among the object's colours as among the background's
   /// (always, for a likelihood made from no pixels).
   bool objectLike(const cv::Vec3b& c) const {

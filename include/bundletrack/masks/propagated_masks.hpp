@@ -43,7 +43,9 @@ struct PropagatedMaskSettings {
   /// The mask stays off the surface the object rested on or leaned against in the first frame
   /// (SupportPlane; found there if there is one): within depth_continuity of that plane, widened
   /// by the noise, where depth cannot tell the object's foot from the support, a pixel joins only
-  /// if its colour is more frequent on the first mask than around it (ColourLikelihood).
+  /// if its colour is more frequent on the first mask than around it (ColourLikelihood), or,
+  /// where colour does not tell them apart in the first frame, only as a seed (agreeing with the
+  /// rendered object: the mask does not grow there).
   bool stop_at_support = true;
 };
 
@@ -64,6 +66,9 @@ class PropagatedMasks {
  public:
   using Settings = PropagatedMaskSettings;
   static constexpr bool kOutlinesObject = true;
+  /// Colour tells the object from its support where at least this share of the first mask and at
+  /// most the rest of its ring look like the object (a two-class rule right on 80 % of each).
+  static constexpr double kColourSeparates = 0.8;
 
   explicit PropagatedMasks(Settings settings = {}) : settings_(settings) {}
 
@@ -76,8 +81,15 @@ class PropagatedMasks {
     support_.reset();
     if (settings_.stop_at_support)
       support_ = findSupportPlane(first, T_cam_obj, settings_.depth_continuity, settings_.hull_dilation_px);
-    colour_ = support_ ? ColourLikelihood(first.color, first.mask, ringAround(first.mask, settings_.hull_dilation_px))
-                       : ColourLikelihood();
+    colour_decides_ = false;
+    if (support_) {
+      // Colour decides only where it tells the first mask from its ring: most of the object looks
+      // like itself and most of the ring does not (a white mug on a white table: neither).
+      const cv::Mat ring = ringAround(first.mask, settings_.hull_dilation_px);
+      colour_ = ColourLikelihood(first.color, first.mask, ring);
+      colour_decides_ = colour_.objectLikeShare(first.color, first.mask) >= kColourSeparates &&
+                        colour_.objectLikeShare(first.color, ring) <= 1.0 - kColourSeparates;
+    }
     const cv::Mat seen = first.mask & (first.depth > 0.0f);
     first_area_ = cv::countNonZero(seen);
     if (first_area_ == 0)
@@ -133,8 +145,9 @@ class PropagatedMasks {
         if (!hull_.contains(p_obj)) continue;
         const float expected = rendered.at<float>(v, u);
         const bool agrees = expected > 0.0f && std::abs(z - expected) <= frame.noise.widen(settings_.depth_agreement, z);
+        // Within the support plane's noise: the object's colour, where it tells, else only seeds.
         if (support_ && support_->distance(p_obj) <= frame.noise.widen(settings_.depth_continuity, z) &&
-            !colour_.objectLike(frame.color.at<cv::Vec3b>(v, u)))
+            (colour_decides_ ? !colour_.objectLike(frame.color.at<cv::Vec3b>(v, u)) : !agrees))
           continue;
         label.at<uchar>(v, u) = agrees ? kObject : kCandidate;
         if (agrees) frontier.emplace_back(u, v);
@@ -233,6 +246,7 @@ class PropagatedMasks {
   FirstViewHull hull_;
   std::optional<SupportPlane> support_;  ///< what the object rested on in the first frame, if anything
   ColourLikelihood colour_;  ///< the first mask's colours against those around it, with a support plane
+  bool colour_decides_ = false;  ///< the likelihood tells the first mask from its ring (kColourSeparates)
   int first_area_ = 0;  ///< pixels of the first mask with depth
   float first_depth_ = 0.0f;  ///< their mean depth
   bool started_ = false;
