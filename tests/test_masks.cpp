@@ -154,7 +154,8 @@ std::optional<bt::SupportPlane> supportInFirstFrame(const synth::SyntheticSequen
   frame_settings.sensor = settings.sensor.depth_noise;
   const bt::RgbdFrame frame = bt::makeFrame("0", f.color, f.depth, f.mask, camera, frame_settings);
   const bt::PropagatedMaskSettings masks;
-  return bt::findSupportPlane(frame, f.T_cam_obj, masks.depth_continuity, masks.hull_dilation_px);
+  return bt::findSupportPlane(frame, f.T_cam_obj, bt::ringAround(frame.mask, masks.hull_dilation_px),
+                              masks.depth_continuity);
 }
 
 }  // namespace

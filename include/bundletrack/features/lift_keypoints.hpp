@@ -3,9 +3,10 @@
 #include <cmath>
 #include <vector>
 
-#include <Eigen/Eigenvalues>
+#include <Eigen/Core>
 #include <opencv2/core.hpp>
 
+#include "bundletrack/core/plane_moments.hpp"
 #include "bundletrack/core/rgbd_frame.hpp"
 #include "bundletrack/features/frame_features.hpp"
 
@@ -18,24 +19,17 @@ namespace bundletrack {
 /// with depth noise), and the fit is also less noisy. Returns zero when fewer than 6 points fit.
 inline Eigen::Vector3f fitNormal(const cv::Mat& points, int u, int v, int r, float max_depth_jump) {
   const cv::Vec3f& c = points.at<cv::Vec3f>(v, u);
-  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
-  Eigen::Matrix3d second = Eigen::Matrix3d::Zero();
-  int count = 0;
+  PlaneMoments moments;
   for (int vv = std::max(0, v - r); vv <= std::min(points.rows - 1, v + r); ++vv) {
     for (int uu = std::max(0, u - r); uu <= std::min(points.cols - 1, u + r); ++uu) {
       const cv::Vec3f& p = points.at<cv::Vec3f>(vv, uu);
       if (p[2] <= 0.0f || std::abs(p[2] - c[2]) > max_depth_jump) continue;
-      const Eigen::Vector3d q(p[0], p[1], p[2]);
-      sum += q;
-      second += q * q.transpose();
-      ++count;
+      moments.add({p[0], p[1], p[2]});
     }
   }
-  if (count < 6) return Eigen::Vector3f::Zero();
-  const Eigen::Vector3d mean = sum / count;
-  const Eigen::Matrix3d covariance = second / count - mean * mean.transpose();
-  Eigen::Vector3d n = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(covariance).eigenvectors().col(0);
-  if (n.dot(mean) > 0.0) n = -n;
+  if (moments.count < 6) return Eigen::Vector3f::Zero();
+  Eigen::Vector3d n = moments.normal();
+  if (n.dot(moments.mean()) > 0.0) n = -n;
   return n.cast<float>();
 }
 

@@ -79,13 +79,12 @@ class PropagatedMasks {
     grid_step_ = grid_step;
     hull_ = FirstViewHull(first, camera, T_cam_obj, settings_.hull_dilation_px, settings_.hull_depth_tolerance);
     support_.reset();
-    if (settings_.stop_at_support)
-      support_ = findSupportPlane(first, T_cam_obj, settings_.depth_continuity, settings_.hull_dilation_px);
+    const cv::Mat ring = ringAround(first.mask, settings_.hull_dilation_px);
+    if (settings_.stop_at_support) support_ = findSupportPlane(first, T_cam_obj, ring, settings_.depth_continuity);
     colour_decides_ = false;
     if (support_) {
       // Colour decides only where it tells the first mask from its ring: most of the object looks
       // like itself and most of the ring does not (a white mug on a white table: neither).
-      const cv::Mat ring = ringAround(first.mask, settings_.hull_dilation_px);
       colour_ = ColourLikelihood(first.color, first.mask, ring);
       colour_decides_ = colour_.objectLikeShare(first.color, first.mask) >= kColourSeparates &&
                         colour_.objectLikeShare(first.color, ring) <= 1.0 - kColourSeparates;

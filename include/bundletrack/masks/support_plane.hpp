@@ -8,11 +8,11 @@
 #include <vector>
 
 #include <Eigen/Core>
-#include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
 #include <opencv2/core.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "bundletrack/core/plane_moments.hpp"
 #include "bundletrack/core/rgbd_frame.hpp"
 #include "bundletrack/core/se3.hpp"
 
@@ -54,14 +54,14 @@ inline cv::Mat ringAround(const cv::Mat& mask, int gap_px) {
 ///   one side), and
 /// - is reached by the object: 2 % of its readings or more lie within `tolerance` of it (it
 ///   touches the plane; an object held in front of a wall does not).
-/// The best such plane (most inliers) is refitted by least squares over its inliers. The ring is
-/// ringAround(mask, gap_px); the mask must be the object's (the first frame's given mask).
-inline std::optional<SupportPlane> findSupportPlane(const RgbdFrame& first, const SE3d& T_cam_obj, float tolerance,
-                                                    int gap_px) {
+/// The best such plane (most inliers) is refitted by least squares over its inliers. `ring` is
+/// ringAround(first.mask, gap) for the mask's registration error; first.mask must be the object's
+/// (the first frame's given mask).
+inline std::optional<SupportPlane> findSupportPlane(const RgbdFrame& first, const SE3d& T_cam_obj, const cv::Mat& ring,
+                                                    float tolerance) {
   constexpr double kMinRingFraction = 0.25, kMaxBehindFraction = 0.02, kMinContactFraction = 0.02;
   const float kMinNormalCosine = std::cos(float(std::numbers::pi) / 4.0f);  // RANSAC's 45 degree normal check
   constexpr int kHypotheses = 256, kMinRingPoints = 30, kMaxObjectPoints = 4000;
-  const cv::Mat ring = ringAround(first.mask, gap_px) & (first.depth > 0.0f);
 
   struct Reading {
     Eigen::Vector3f p, n;
@@ -128,18 +128,12 @@ inline std::optional<SupportPlane> findSupportPlane(const RgbdFrame& first, cons
   if (!best) return std::nullopt;
   // Least squares over the inliers (centroid and the covariance's least direction): within the
   // tolerance slab the best hypothesis may lie off-centre by up to the tolerance.
-  Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
-  Eigen::Matrix3d moment = Eigen::Matrix3d::Zero();
-  for (const Reading& r : around) {
-    if (!isInlier(*best, r)) continue;
-    const Eigen::Vector3d p = r.p.cast<double>();
-    centroid += p;
-    moment += p * p.transpose();
-  }
-  centroid /= double(best_inliers);
-  const Eigen::Matrix3d covariance = moment / double(best_inliers) - centroid * centroid.transpose();
-  Eigen::Vector3d normal = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(covariance).eigenvectors().col(0);
+  PlaneMoments inliers;
+  for (const Reading& r : around)
+    if (isInlier(*best, r)) inliers.add(r.p.cast<double>());
+  Eigen::Vector3d normal = inliers.normal();
   if (normal.dot(best->normal().cast<double>()) < 0.0) normal = -normal;
+  const Eigen::Vector3d centroid = inliers.mean();
   if (const auto refined = supporting(Plane(normal.cast<float>(), centroid.cast<float>()))) best = refined;
   const SE3d T_obj_cam = T_cam_obj.inverse();
   const Eigen::Vector3d n_cam = best->normal().cast<double>(), on_cam = -double(best->offset()) * n_cam;
