@@ -8,7 +8,6 @@
 #include <vector>
 
 #include "bundletrack/core/error.hpp"
-#include "bundletrack/core/execution.hpp"
 #include "bundletrack/tracking/any_tracker.hpp"
 
 namespace bundletrack {
@@ -16,15 +15,17 @@ namespace bundletrack {
 /// Several rigid objects in one camera. Each object has a tracker of its own (its keyframes, its
 /// pose graph, its lost frames) made by `make`; they share the frame: the caller preprocesses it
 /// once, over regionOfInterest (the union of the objects' regions, so every tracker finds inside
-/// its own region what it would find alone), and track() runs the objects side by side on the
-/// thread pool. An object starts with the first frame that brings it a non-empty mask, so objects
+/// its own region what it would find alone), and track() runs the objects one after another, each
+/// tracker with its own parallel loops over the thread pool: side by side, each tracker on one
+/// thread, a frame waited for the slower object, and the whole run took 1.16x as long with two
+/// objects on two cores, 1.04x with three (bench/multi_object.sh, medians of five alternating
+/// runs). An object starts with the first frame that brings it a non-empty mask, so objects
 /// can enter at different frames; each result is the one its tracker gives alone on that frame.
 class MultiObjectTracker {
  public:
   using MakeTracker = std::function<std::unique_ptr<AnyTracker>()>;
 
-  MultiObjectTracker(std::size_t objects, const MakeTracker& make, Execution execution = Execution::Parallel)
-      : trackers_(objects), started_(objects, false), execution_(execution) {
+  MultiObjectTracker(std::size_t objects, const MakeTracker& make) : trackers_(objects), started_(objects, false) {
     for (auto& tracker : trackers_) tracker = make();
   }
 
@@ -61,16 +62,14 @@ class MultiObjectTracker {
       throw InputError("MultiObjectTracker::track", "needs one start pose per object (" + std::to_string(size()) +
                                                         "), got " + std::to_string(start_poses.size()));
     std::vector<std::optional<TrackResult>> results(size());
-    // One object alone runs its tracker's own parallel loops; several run side by side, each on one thread.
-    forEachIndex(size() > 1 ? execution_ : Execution::Serial, int(size()), [&](int index) {
-      const auto k = std::size_t(index);
-      if (!masks[k]) return;
+    for (std::size_t k = 0; k < size(); ++k) {
+      if (!masks[k]) continue;
       const bool starts = !started_[k] && startsWith(*masks[k]);
-      if (!started_[k] && !starts) return;
+      if (!started_[k] && !starts) continue;
       RgbdFrame own = frame;  // shares the images; the object's own mask
       own.mask = *masks[k];
       results[k] = starts ? trackers_[k]->initialize(own, start_poses[k]) : trackers_[k]->track(own);
-    });
+    }
     for (std::size_t k = 0; k < size(); ++k) started_[k] = started_[k] || results[k].has_value();
     return results;
   }
@@ -86,7 +85,6 @@ class MultiObjectTracker {
 
   std::vector<std::unique_ptr<AnyTracker>> trackers_;
   std::vector<bool> started_;
-  Execution execution_;
 };
 
 }  // namespace bundletrack
