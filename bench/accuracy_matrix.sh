@@ -6,12 +6,13 @@
 # (bundletrack_eval --in-view; they differ where the object leaves the view). With --before, a
 # second build's tracker runs on the very same sequences and its columns stand beside.
 #
-# The design is sparse (54 synthetic cells, not the 144 of the full product), chosen so that each
+# The design is sparse (56 synthetic cells, not the 144 of the full product), chosen so that each
 # factor varies with the others held at their usual value:
 #   A  distance {0.5, 1, 2, 3 m} x object {mug 0.10 m, box 0.20 m, chair 0.70 m} x {textured,
 #      textureless}, structured light, normal speed (no chair at 0.5 m: it would not fit the view);
 #   B  sensor {active stereo, time of flight} x distance {1, 3 m} x object, textured;
-#   C  fast motion (3x) x {box, mug} x {1, 2 m}, textured;
+#   C  fast motion (3x) x {box, mug} x {1, 2 m}, textured; at 1 m also with the colour averaged over
+#      8 instants of the exposure (bundletrack_synth --motion-blur 8), as a hand-held camera blurs;
 #   D  an occluder (box, 1 m) and the object carried out of view and back (box at 1 m; textureless
 #      chair at 2.5 m).
 #   E  masks that err from the object's outline by 3 px, as a segmentation's or a depth-to-colour
@@ -72,6 +73,7 @@ for s in active_stereo time_of_flight; do
 done
 for o in box mug; do
   for d in 1 2; do cells+=("C_${o}_${d}m_fast|--shape $o --size $(size_of $o) --distance $d --speed 3"); done
+  cells+=("C_${o}_1m_fast_blur8|--shape $o --size $(size_of $o) --distance 1 --speed 3 --motion-blur 8")
 done
 cells+=("D_box_1m_occluder|--shape box --distance 1 --occluder")
 cells+=("D_box_1m_out_of_view|--shape box --distance 1 --out-of-view 40 15")
