@@ -7,6 +7,7 @@
 #include <thread>
 #include <vector>
 
+#include "bundletrack/io/png_decoder.hpp"
 #include "bundletrack/io/read_ahead.hpp"
 #include "bundletrack/io/rgbd_sequence.hpp"
 #include "shared_data.hpp"
@@ -177,7 +178,7 @@ TEST_CASE("bad input raises InputError naming the file and the problem") {
   }
   SUBCASE("a PNG header over garbage") {
     writeText(root / "rgb" / "2.png", std::string("\x89PNG\r\n\x1a\n", 8) + "garbage IEND");
-    checkInputError([&] { open().frame(1); }, root / "rgb" / "2.png", "cannot decode");
+    checkInputError([&] { open().frame(1); }, root / "rgb" / "2.png", "corrupt PNG image");
   }
   SUBCASE("another format's file: OpenCV's DICOM decoder aborted on this one (fuzz_sequence_files)") {
     std::string dicom(128, '\xff');
@@ -233,6 +234,144 @@ TEST_CASE("bad input raises InputError naming the file and the problem") {
   SUBCASE("model file with a malformed line") {
     writeText(root / "model" / "points.xyz", "0 0 0\n0.1 x 0\n");
     checkInputError([&] { open().modelPoints(); }, root / "model" / "points.xyz", "line 2");
+  }
+}
+
+namespace {
+
+void appendBigEndian32(std::vector<uchar>& out, std::uint32_t value) {
+  for (const int shift : {24, 16, 8, 0}) out.push_back(uchar(value >> shift));
+}
+
+// A PNG chunk with its length and CRC.
+void appendChunk(std::vector<uchar>& png, const std::string& type, const std::vector<uchar>& data) {
+  appendBigEndian32(png, std::uint32_t(data.size()));
+  std::vector<uchar> typed(type.begin(), type.end());
+  typed.insert(typed.end(), data.begin(), data.end());
+  png.insert(png.end(), typed.begin(), typed.end());
+  appendBigEndian32(png, std::uint32_t(libdeflate_crc32(0, typed.data(), typed.size())));
+}
+
+// A PNG of `image` (8-bit grey, RGB from BGR, RGBA from BGRA, or 16-bit grey) whose row v is
+// written with filter type v % 5 (PNG specification, section 9.2), so that every filter is used;
+// OpenCV's encoder chooses its own filters.
+std::vector<uchar> pngWithEveryFilter(const cv::Mat& image) {
+  const int channels = image.channels(), bpp = channels * int(image.elemSize1());
+  const int colour_type = channels == 1 ? 0 : channels == 3 ? 2 : 6;
+  const std::size_t row_bytes = std::size_t(bpp) * std::size_t(image.cols);
+  std::vector<uchar> previous(row_bytes, 0), filtered;
+  for (int v = 0; v < image.rows; ++v) {
+    std::vector<uchar> row(row_bytes);  // PNG's byte order: RGB(A), 16-bit big-endian
+    for (int u = 0; u < image.cols; ++u) {
+      uchar* px = &row[std::size_t(u * bpp)];
+      if (image.depth() == CV_16U) {
+        const std::uint16_t z = image.at<std::uint16_t>(v, u);
+        px[0] = uchar(z >> 8), px[1] = uchar(z & 0xff);
+      } else {
+        const uchar* in = image.ptr(v) + u * channels;
+        for (int c = 0; c < channels; ++c) px[c] = in[c];
+        if (channels >= 3) std::swap(px[0], px[2]);
+      }
+    }
+    const int filter = v % 5;
+    filtered.push_back(uchar(filter));
+    for (std::size_t i = 0; i < row_bytes; ++i) {
+      const int a = i >= std::size_t(bpp) ? row[i - std::size_t(bpp)] : 0, b = previous[i];
+      const int c = i >= std::size_t(bpp) ? previous[i - std::size_t(bpp)] : 0;
+      const int prediction = filter == 1 ? a : filter == 2 ? b : filter == 3 ? (a + b) / 2 : filter == 4 ? bt::io::detail::paeth(a, b, c) : 0;
+      filtered.push_back(uchar(row[i] - prediction));
+    }
+    previous = row;
+  }
+  std::vector<uchar> compressed(libdeflate_zlib_compress_bound(nullptr, filtered.size()));
+  libdeflate_compressor* compressor = libdeflate_alloc_compressor(6);
+  compressed.resize(libdeflate_zlib_compress(compressor, filtered.data(), filtered.size(), compressed.data(), compressed.size()));
+  libdeflate_free_compressor(compressor);
+  std::vector<uchar> png = {0x89, 'P', 'N', 'G', 0x0D, 0x0A, 0x1A, 0x0A}, header;
+  appendBigEndian32(header, std::uint32_t(image.cols));
+  appendBigEndian32(header, std::uint32_t(image.rows));
+  header.insert(header.end(), {uchar(8 * image.elemSize1()), uchar(colour_type), 0, 0, 0});
+  appendChunk(png, "IHDR", header);
+  const std::size_t half = compressed.size() / 2;  // image data in two IDAT chunks, as encoders split it
+  appendChunk(png, "IDAT", std::vector<uchar>(compressed.begin(), compressed.begin() + std::ptrdiff_t(half)));
+  appendChunk(png, "IDAT", std::vector<uchar>(compressed.begin() + std::ptrdiff_t(half), compressed.end()));
+  appendChunk(png, "IEND", {});
+  return png;
+}
+
+bool samePixels(const cv::Mat& a, const cv::Mat& b) {
+  return a.type() == b.type() && a.size() == b.size() && cv::norm(a, b, cv::NORM_INF) == 0.0;
+}
+
+}  // namespace
+
+TEST_CASE("PNG decoding gives OpenCV's pixels for the layouts of RGB-D recordings, with every filter") {
+  cv::RNG rng(7);
+  for (const int type : {CV_8UC1, CV_16UC1, CV_8UC3, CV_8UC4}) {
+    // Odd sizes; noise and a smooth ramp (on which encoders pick different filters).
+    cv::Mat noise(23, 37, type), ramp(23, 37, type);
+    rng.fill(noise, cv::RNG::UNIFORM, 0, type == CV_16UC1 ? 65536 : 256);
+    for (int v = 0; v < ramp.rows; ++v)
+      for (int u = 0; u < ramp.cols * ramp.channels(); ++u) {
+        const int value = 40 * v + 7 * u;
+        if (type == CV_16UC1) ramp.at<std::uint16_t>(v, u) = std::uint16_t(800 + value);
+        else ramp.ptr(v)[u] = uchar(value);
+      }
+    for (const cv::Mat& image : {noise, ramp}) {
+      std::vector<uchar> by_opencv;
+      cv::imencode(".png", image, by_opencv);
+      for (const std::vector<uchar>& png : {by_opencv, pngWithEveryFilter(image)}) {
+        CAPTURE(type);
+        const bt::io::PngDecoding ours = bt::io::decodePng(png, cv::IMREAD_UNCHANGED);
+        REQUIRE(ours.error.empty());
+        CHECK(samePixels(ours.image, image));
+        CHECK(samePixels(ours.image, cv::imdecode(png, cv::IMREAD_UNCHANGED)));
+        const bt::io::PngDecoding colour = bt::io::decodePng(png, cv::IMREAD_COLOR);
+        if (image.channels() == 1) {  // grey as colour: left to OpenCV
+          CHECK((colour.image.empty() && colour.error.empty()));
+        } else {
+          CHECK(samePixels(colour.image, cv::imdecode(png, cv::IMREAD_COLOR)));
+          CHECK(colour.image.channels() == 3);
+        }
+        CHECK(samePixels(bt::io::decodeImage(png, cv::IMREAD_COLOR, "x.png"), cv::imdecode(png, cv::IMREAD_COLOR)));
+      }
+    }
+  }
+}
+
+TEST_CASE("a corrupt PNG is an error naming the chunk or the stream, a damaged ancillary chunk is skipped") {
+  cv::Mat image(20, 30, CV_16UC1);
+  cv::RNG(3).fill(image, cv::RNG::UNIFORM, 500, 5000);
+  const std::vector<uchar> png = pngWithEveryFilter(image);
+  const std::size_t first_idat = 8 + 25;  // signature, IHDR (12 + 13 bytes)
+  SUBCASE("a flipped byte in the image data fails the chunk's CRC") {
+    std::vector<uchar> bad = png;
+    bad[first_idat + 8 + 3] ^= 0x10;
+    const bt::io::PngDecoding ours = bt::io::decodePng(bad, cv::IMREAD_UNCHANGED);
+    CHECK(ours.image.empty());
+    CHECK(ours.error == "chunk IDAT fails its CRC");
+    checkInputError([&] { bt::io::decodeImage(bad, cv::IMREAD_UNCHANGED, "depth/7.png"); }, "depth/7.png",
+                    "corrupt PNG image: chunk IDAT fails its CRC");
+  }
+  SUBCASE("a broken zlib stream under a right CRC") {
+    std::vector<uchar> bad = png;
+    const std::uint32_t length = std::uint32_t(bad[first_idat]) << 24 | std::uint32_t(bad[first_idat + 1]) << 16 |
+                                 std::uint32_t(bad[first_idat + 2]) << 8 | bad[first_idat + 3];
+    for (std::size_t i = 2; i < length; ++i) bad[first_idat + 8 + i] = 0xff;  // past the zlib header
+    const std::uint32_t crc = std::uint32_t(libdeflate_crc32(0, &bad[first_idat + 4], length + 4));
+    for (int k = 0; k < 4; ++k) bad[first_idat + 8 + length + std::size_t(k)] = uchar(crc >> (24 - 8 * k));
+    CHECK(bt::io::decodePng(bad, cv::IMREAD_UNCHANGED).error == "corrupt or truncated image data (zlib stream)");
+  }
+  SUBCASE("a text chunk with a wrong CRC") {
+    std::vector<uchar> text_chunk;
+    appendChunk(text_chunk, "tEXt", {'a', 0, 'b'});
+    text_chunk.back() ^= 1;
+    std::vector<uchar> with_text = png;
+    with_text.insert(with_text.begin() + std::ptrdiff_t(first_idat), text_chunk.begin(), text_chunk.end());
+    const bt::io::PngDecoding ours = bt::io::decodePng(with_text, cv::IMREAD_UNCHANGED);
+    CHECK(ours.error.empty());
+    CHECK(samePixels(ours.image, image));
+    CHECK(samePixels(ours.image, cv::imdecode(with_text, cv::IMREAD_UNCHANGED)));
   }
 }
 

@@ -13,6 +13,7 @@
 
 #include "bundletrack/core/error.hpp"
 #include "bundletrack/io/file_access.hpp"
+#include "bundletrack/io/png_decoder.hpp"
 
 namespace bundletrack::io {
 
@@ -53,13 +54,17 @@ inline bool isPngOrJpeg(const std::vector<uchar>& bytes) {
 /// Decodes an encoded image (the bytes of `path`); an empty, truncated or undecodable one is an
 /// InputError, and so is any format but PNG and JPEG (the layouts' formats): OpenCV picks a
 /// decoder by the content, and some abort the process on malformed input (its DICOM reader
-/// asserts, found by fuzz_sequence_files).
+/// asserts, found by fuzz_sequence_files). The PNG layouts of RGB-D recordings go through
+/// decodePng (the same pixels, in half the time), the rest through cv::imdecode.
 inline cv::Mat decodeImage(const std::vector<uchar>& bytes, int flags, const std::filesystem::path& path) {
   if (bytes.empty()) throw InputError(path, "empty file");
   if (!isPngOrJpeg(bytes)) throw InputError(path, "not a PNG or JPEG image (images must be .png or .jpg)");
   if (!endsComplete(bytes))
     throw InputError(path, "truncated or corrupt image: it ends without its format's end marker (" +
                                std::to_string(bytes.size()) + " bytes)");
+  PngDecoding png = decodePng(bytes, flags);
+  if (!png.error.empty()) throw InputError(path, "corrupt PNG image: " + png.error);
+  if (!png.image.empty()) return png.image;
   cv::Mat image;
   try {
     image = cv::imdecode(bytes, flags);
