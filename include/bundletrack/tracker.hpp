@@ -244,18 +244,20 @@ class Tracker {
     return false;
   }
 
-  /// Matches two frames' features (gated when their relative pose is known) and registers them.
+  /// Matches two frames' features (gated when their relative pose is known) and registers them,
+  /// charging the two steps to their stages on `clock` where one is given (none: the call may run
+  /// beside others, see buildGraph).
   struct PairRegistration {
     std::vector<FeatureMatch> matches;
     std::vector<FeatureMatch> inliers;
     SE3d T_second_first;
   };
-  PairRegistration registerPair(const FrameFeatures& first, const FrameFeatures& second,
-                                const std::optional<MatchGate>& gate) {
+  PairRegistration registerPair(const FrameFeatures& first, const FrameFeatures& second, const std::optional<MatchGate>& gate,
+                                StageClock* clock) const {
+    const auto timed = [clock](Stage stage, auto&& step) { return clock ? clock->measure(stage, step) : step(); };
     PairRegistration pair;
-    pair.matches = clock_.measure(&StageTimings::matching, [&] { return correspondences_.match(first, second, gate); });
-    const auto estimate =
-        clock_.measure(&StageTimings::ransac, [&] { return registration_.estimate(first, second, pair.matches); });
+    pair.matches = timed(&StageTimings::matching, [&] { return correspondences_.match(first, second, gate); });
+    const auto estimate = timed(&StageTimings::ransac, [&] { return registration_.estimate(first, second, pair.matches); });
     for (const int k : estimate.inliers) pair.inliers.push_back(pair.matches[std::size_t(k)]);
     pair.T_second_first = estimate.T_second_first;
     return pair;
@@ -266,7 +268,7 @@ class Tracker {
   /// are also kept aside for refineFromFollowing.
   bool estimateCoarsePose(FrameContext& ctx) {
     const KeypointFrame& last = last_->keypoints;
-    PairRegistration from_last = registerPair(last.features, ctx.features, std::nullopt);
+    PairRegistration from_last = registerPair(last.features, ctx.features, std::nullopt, &clock_);
     ctx.result.matches = int(from_last.matches.size());
     ctx.result.inliers = int(from_last.inliers.size());
     if (ctx.recovering) return reacquisitionCandidates(ctx, std::move(from_last));
@@ -302,7 +304,7 @@ class Tracker {
     if (last_inliers < settings_.recovery_min_inliers) {
       for (const RelocalisedPose& pose :
            relocalise(pool_, last_->T_cam_obj.rotation(), settings_.max_keyframes, settings_.min_inliers,
-                      [&](const Keyframe& keyframe) { return registerPair(keyframe.features, ctx.features, std::nullopt); }))
+                      [&](const Keyframe& keyframe) { return registerPair(keyframe.features, ctx.features, std::nullopt, &clock_); }))
         registered.push_back({pose.inliers, {pose.T_cam_obj, true, false, Evidence::Features, {}}});
       std::stable_sort(registered.begin(), registered.end(),
                        [](const auto& a, const auto& b) { return a.first > b.first; });
@@ -461,22 +463,30 @@ class Tracker {
   }
 
   /// Paper IV-C, IV-D: the current frame and the keyframes selected for its coarse pose, all pairs.
+  /// The edges' correspondences (matching and RANSAC) are charged to the matching stage; the
+  /// current frame's edges are matched on OpenCV's threads where both policies allow concurrent
+  /// calls (ConcurrentCalls: the CPU ones; a GPU backend's are called from one thread).
   void buildGraph(FrameContext& ctx) {
+    constexpr Execution edges = ConcurrentCalls<Correspondences> && ConcurrentCalls<Registration> ? Execution::Parallel
+                                                                                                   : Execution::Serial;
     const LastFrameLink last{last_->keypoints.id, ctx.coarse.from_last ? &ctx.coarse.last_inliers : nullptr};
-    ctx.graph = buildPoseGraph(pool_, settings_.max_keyframes, ctx.current, ctx.coarse.T_cam_obj, last, cache_,
-                               [&](const Keyframe& a, const Keyframe& b, const SE3d& T_a, const SE3d& T_b) {
-                                 return edgeCorrespondences(a, b, T_a, T_b);
-                               });
+    ctx.graph = clock_.measure(&StageTimings::matching, [&] {
+      return buildPoseGraph(pool_, settings_.max_keyframes, ctx.current, ctx.coarse.T_cam_obj, last, cache_,
+                            [&](const Keyframe& a, const Keyframe& b, const SE3d& T_a, const SE3d& T_b) {
+                              return edgeCorrespondences(a, b, T_a, T_b);
+                            },
+                            edges);
+    });
   }
 
   /// Feature correspondences of an edge (paper IV-D): matches gated by the current poses (the gate
   /// widened for the sensor's noise), pruned by RANSAC; fewer than min_edge_correspondences count
   /// as none, so a frame with fewer features (one tracked without keypoints) is not matched at all.
-  std::vector<FeatureMatch> edgeCorrespondences(const Keyframe& a, const Keyframe& b, const SE3d& T_a, const SE3d& T_b) {
+  std::vector<FeatureMatch> edgeCorrespondences(const Keyframe& a, const Keyframe& b, const SE3d& T_a, const SE3d& T_b) const {
     const auto fewest = std::size_t(std::max(0, settings_.min_edge_correspondences));
     if (a.features.size() < fewest || b.features.size() < fewest) return {};
     const SurfaceGate gate = settings_.edge_gate.widened(NoiseScale::between(a.features.noise_scale, b.features.noise_scale));
-    PairRegistration pair = registerPair(a.features, b.features, MatchGate{(T_b * T_a.inverse()).cast<float>(), gate});
+    PairRegistration pair = registerPair(a.features, b.features, MatchGate{(T_b * T_a.inverse()).cast<float>(), gate}, nullptr);
     if (int(pair.inliers.size()) < settings_.min_edge_correspondences) return {};
     return std::move(pair.inliers);
   }

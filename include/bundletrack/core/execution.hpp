@@ -9,6 +9,12 @@ namespace bundletrack {
 /// so both choices give bit-identical results.
 enum class Execution { Serial, Parallel };
 
+/// A policy whose const member functions may run on several threads at once: it keeps no state
+/// between calls (`static constexpr bool kConcurrentCalls = true`). A GPU backend's device buffers
+/// are such state, so its policies leave the flag out and are called from one thread.
+template <typename T>
+concept ConcurrentCalls = requires { requires T::kConcurrentCalls; };
+
 /// body(k) for k in [0, count), on OpenCV's thread pool when `execution` is Parallel.
 template <typename Body>
 void forEachIndex(Execution execution, int count, Body&& body) {

@@ -27,6 +27,8 @@ struct CropSettings {
 /// max_keypoints strongest, map them back to full resolution, lift them to 3-D.
 class OpenCvFeatureSource {
  public:
+  static constexpr bool kConcurrentCalls = true;  ///< match() and follow() keep no state (ConcurrentCalls)
+
   FrameFeatures detect(const RgbdFrame& frame) {
     if (frame.mask.empty() || cv::countNonZero(frame.mask) == 0) {
       FrameFeatures none;

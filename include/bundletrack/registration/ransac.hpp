@@ -96,6 +96,8 @@ concept TrialScorer = requires(T& scorer, const MatchedPoints& pairs, const Rans
 /// (settings.execution: in parallel, or one by one).
 class CpuTrialScorer {
  public:
+  static constexpr bool kConcurrentCalls = true;  ///< keeps no state between calls (ConcurrentCalls)
+
   void prepare(const MatchedPoints&) {}
 
   void score(const MatchedPoints& pairs, const RansacSettings& settings, const InlierGate& gate, int first, int count,
@@ -128,6 +130,9 @@ class CpuTrialScorer {
 template <TrialScorer Scorer>
 class BasicRansac {
  public:
+  /// Concurrent estimate() calls are safe where the scorer's are (ConcurrentCalls).
+  static constexpr bool kConcurrentCalls = ConcurrentCalls<Scorer>;
+
   explicit BasicRansac(RansacSettings settings = {}, Scorer scorer = Scorer())
       : settings_(settings), scorer_(std::move(scorer)) {}
   const RansacSettings& settings() const { return settings_; }

@@ -31,7 +31,9 @@ inline std::optional<TrackStatus> statusFromName(std::string_view name) {
   return std::nullopt;
 }
 
-/// Wall-clock milliseconds spent per stage of one frame.
+/// Wall-clock milliseconds spent per stage of one frame. `matching` and `ransac` are the coarse
+/// step's (and following's RANSAC); the pose graph's edge correspondences, each edge matched and
+/// pruned by RANSAC (in parallel over the current frame's edges), are all `matching`.
 struct StageTimings {
   double mask = 0.0, features = 0.0, matching = 0.0, ransac = 0.0, graph = 0.0, solve = 0.0, total = 0.0;
 };
