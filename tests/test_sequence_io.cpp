@@ -362,6 +362,15 @@ TEST_CASE("a corrupt PNG is an error naming the chunk or the stream, a damaged a
     for (int k = 0; k < 4; ++k) bad[first_idat + 8 + length + std::size_t(k)] = uchar(crc >> (24 - 8 * k));
     CHECK(bt::io::decodePng(bad, cv::IMREAD_UNCHANGED).error == "corrupt or truncated image data (zlib stream)");
   }
+  SUBCASE("a header that claims more pixels than the image data can hold") {
+    std::vector<uchar> bad = png;
+    bad[8 + 8 + 1] = 0x01;  // width 30 -> 65,566 (big-endian bytes 0x00 0x01 0x00 0x1e)
+    const std::uint32_t crc = std::uint32_t(libdeflate_crc32(0, &bad[8 + 4], 17));
+    for (int k = 0; k < 4; ++k) bad[8 + 8 + 13 + std::size_t(k)] = uchar(crc >> (24 - 8 * k));
+    const bt::io::PngDecoding ours = bt::io::decodePng(bad, cv::IMREAD_UNCHANGED);
+    CHECK(ours.image.empty());
+    CHECK(ours.error.find("cannot fill a 65566 x 20 image") != std::string::npos);
+  }
   SUBCASE("a text chunk with a wrong CRC") {
     std::vector<uchar> text_chunk;
     appendChunk(text_chunk, "tEXt", {'a', 0, 'b'});

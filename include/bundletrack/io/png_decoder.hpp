@@ -142,6 +142,11 @@ inline PngDecoding decodePng(const std::vector<uchar>& bytes, int flags) {
                        (bit_depth == 16 && grey && flags == cv::IMREAD_UNCHANGED);
   if (!handled) return out;
   const std::size_t bpp = channels * std::size_t(bit_depth / 8), row_bytes = bpp * width;
+  // Deflate expands at most 1032-fold: a header that claims more than its data can hold is refused
+  // before the image's buffer is allocated.
+  if ((row_bytes + 1) * height > 1032 * compressed.size() + 1032)
+    return {{}, "image data of " + std::to_string(compressed.size()) + " bytes cannot fill a " + std::to_string(width) + " x " +
+                    std::to_string(height) + " image"};
   raw.resize((row_bytes + 1) * height);
   static thread_local std::unique_ptr<libdeflate_decompressor, detail::DecompressorDeleter> inflater(
       libdeflate_alloc_decompressor());
