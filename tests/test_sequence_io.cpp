@@ -252,6 +252,13 @@ void appendChunk(std::vector<uchar>& png, const std::string& type, const std::ve
   appendBigEndian32(png, std::uint32_t(libdeflate_crc32(0, typed.data(), typed.size())));
 }
 
+// Writes the CRC of the chunk at byte `chunk` of `png` anew, after its data was changed.
+void rewriteCrc(std::vector<uchar>& png, std::size_t chunk) {
+  const std::uint32_t length = bt::io::detail::bigEndian32(&png[chunk]);
+  const std::uint32_t crc = std::uint32_t(libdeflate_crc32(0, &png[chunk + 4], length + 4));
+  for (int k = 0; k < 4; ++k) png[chunk + 8 + length + std::size_t(k)] = uchar(crc >> (24 - 8 * k));
+}
+
 // A PNG of `image` (8-bit grey, RGB from BGR, RGBA from BGRA, or 16-bit grey) whose row v is
 // written with filter type v % 5 (PNG specification, section 9.2), so that every filter is used;
 // OpenCV's encoder chooses its own filters.
@@ -355,18 +362,15 @@ TEST_CASE("a corrupt PNG is an error naming the chunk or the stream, a damaged a
   }
   SUBCASE("a broken zlib stream under a right CRC") {
     std::vector<uchar> bad = png;
-    const std::uint32_t length = std::uint32_t(bad[first_idat]) << 24 | std::uint32_t(bad[first_idat + 1]) << 16 |
-                                 std::uint32_t(bad[first_idat + 2]) << 8 | bad[first_idat + 3];
+    const std::uint32_t length = bt::io::detail::bigEndian32(&bad[first_idat]);
     for (std::size_t i = 2; i < length; ++i) bad[first_idat + 8 + i] = 0xff;  // past the zlib header
-    const std::uint32_t crc = std::uint32_t(libdeflate_crc32(0, &bad[first_idat + 4], length + 4));
-    for (int k = 0; k < 4; ++k) bad[first_idat + 8 + length + std::size_t(k)] = uchar(crc >> (24 - 8 * k));
+    rewriteCrc(bad, first_idat);
     CHECK(bt::io::decodePng(bad, cv::IMREAD_UNCHANGED).error == "corrupt or truncated image data (zlib stream)");
   }
   SUBCASE("a header that claims more pixels than the image data can hold") {
     std::vector<uchar> bad = png;
     bad[8 + 8 + 1] = 0x01;  // width 30 -> 65,566 (big-endian bytes 0x00 0x01 0x00 0x1e)
-    const std::uint32_t crc = std::uint32_t(libdeflate_crc32(0, &bad[8 + 4], 17));
-    for (int k = 0; k < 4; ++k) bad[8 + 8 + 13 + std::size_t(k)] = uchar(crc >> (24 - 8 * k));
+    rewriteCrc(bad, 8);
     const bt::io::PngDecoding ours = bt::io::decodePng(bad, cv::IMREAD_UNCHANGED);
     CHECK(ours.image.empty());
     CHECK(ours.error.find("cannot fill a 65566 x 20 image") != std::string::npos);
