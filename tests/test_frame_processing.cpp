@@ -209,6 +209,25 @@ TEST_CASE("a frame preprocessed inside a region equals the whole image's preproc
   }
 }
 
+TEST_CASE("the depth camera's view is the bounding box of the raw depth's readings") {
+  // A depth image registered to a wider colour camera: no reading in its first 3 and last 5 columns
+  // and its first 2 and last 4 rows; within them, a far background without readings (rows 10-30).
+  cv::Mat raw(40, 60, CV_32FC1, cv::Scalar(1.5f));
+  raw.colRange(0, 3).setTo(0.0f);
+  raw.colRange(55, 60).setTo(0.0f);
+  raw.rowRange(0, 2).setTo(0.0f);
+  raw.rowRange(36, 40).setTo(0.0f);
+  raw.rowRange(10, 30).setTo(0.0f);
+  CHECK(bt::depthCameraView(raw) == cv::Rect(3, 2, 52, 34));
+  raw.at<float>(0, 59) = std::numeric_limits<float>::quiet_NaN();  // not a reading
+  raw.at<float>(38, 1) = 2.0f;  // one reading stretches the box to it
+  CHECK(bt::depthCameraView(raw) == cv::Rect(1, 2, 54, 37));
+  CHECK(bt::depthCameraView(cv::Mat::zeros(40, 60, CV_32FC1)).empty());
+  // makeFrame keeps it whatever region it preprocesses.
+  CHECK(bt::makeFrame("0", cv::Mat(40, 60, CV_8UC3), raw, {}, kCamera, {}, cv::Rect(20, 20, 5, 5)).depth_view ==
+        cv::Rect(1, 2, 54, 37));
+}
+
 TEST_CASE("a frame preprocessed ahead is used where the tracker asks for its region, and made again elsewhere") {
   const cv::Size size(128, 96);
   const cv::Mat depth = planeDepth(Eigen::Vector3f(0.1f, 0.2f, -1.0f).normalized(), -0.9f, size);

@@ -211,7 +211,7 @@ TEST_CASE("propagated mask: a chair's legs stand on the floor, the mask stops at
   bt::KeyframePool pool(15);
   for (const int i : {0, 25, 50, 75}) {
     const auto [frame, f] = frameAt(i, true);
-    pool.add(bt::makeKeyframe(i, frame, frame.mask, {}, f.T_cam_obj, camera, step, false, false));
+    pool.add(bt::makeKeyframe(i, frame, frame.mask, {}, f.T_cam_obj, camera, step, false, bt::MaskOutline::none));
   }
   // Mask pixels off the chair (false positives) and the chair's pixels found, per frame.
   const auto propagate = [&](bool stop_at_support, bool grey) {

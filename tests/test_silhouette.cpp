@@ -3,6 +3,7 @@
 #include <doctest/doctest.h>
 
 #include <cmath>
+#include <limits>
 
 #include "bundletrack/core/silhouette_image.hpp"
 #include "bundletrack/residuals/dense_silhouette.hpp"
@@ -14,8 +15,9 @@ namespace {
 const bt::PinholeCameraf kCamera{100.0f, 100.0f, 49.5f, 39.5f};
 
 /// A 100 x 80 frame: the object a rectangle of columns 30-49 and rows 20-39 at 1 m before a wall at
-/// 2 m, an occluder at 0.5 m over columns 60-69 and rows 20-39 (not in the mask), no reading in
-/// columns 30-49 of rows 45-54, and a surface at 0.995 m over columns 30-49 of rows 5-14.
+/// 2 m, an occluder at 0.5 m over columns 60-69 and rows 20-39 (not in the mask) whose rim, columns
+/// 58-59, has no reading, no reading in columns 30-49 of rows 45-54 (beyond the sensor's range), a
+/// surface at 0.995 m over columns 30-49 of rows 5-14, and rows 60-79 beyond the depth camera's view.
 bt::RgbdFrame rectangleFrame() {
   bt::RgbdFrame frame;
   frame.mask = cv::Mat::zeros(80, 100, CV_8UC1);
@@ -23,8 +25,12 @@ bt::RgbdFrame rectangleFrame() {
   frame.depth = cv::Mat(80, 100, CV_32FC1, cv::Scalar(2.0f));
   frame.depth(cv::Rect(30, 20, 20, 20)).setTo(1.0f);
   frame.depth(cv::Rect(60, 20, 10, 20)).setTo(0.5f);
+  frame.depth(cv::Rect(58, 20, 2, 20)).setTo(0.0f);
   frame.depth(cv::Rect(30, 45, 20, 10)).setTo(0.0f);
   frame.depth(cv::Rect(30, 5, 20, 10)).setTo(0.995f);
+  frame.depth.rowRange(60, 80).setTo(0.0f);
+  frame.depth_view = bt::depthCameraView(frame.depth);
+  REQUIRE(frame.depth_view == cv::Rect(0, 0, 100, 60));
   frame.points.create(80, 100, CV_32FC3);
   for (int v = 0; v < 80; ++v)
     for (int u = 0; u < 100; ++u) {
@@ -37,8 +43,8 @@ bt::RgbdFrame rectangleFrame() {
 }  // namespace
 
 TEST_CASE("the silhouette image is the signed distance to the mask's outline") {
-  const bt::RgbdFrame frame = rectangleFrame();
-  const bt::SilhouetteImage image = bt::makeSilhouetteImage(frame, frame.mask, 2, 10);
+  bt::RgbdFrame frame = rectangleFrame();
+  const bt::SilhouetteImage image = bt::makeSilhouetteImage(frame, frame.mask, bt::MaskOutline::every_pixel, 2, 10);
   CHECK(image.box == cv::Rect(20, 10, 40, 40));
   const auto distance = [&](double u, double v) {
     double d = 0.0, du = 0.0, dv = 0.0;
@@ -66,14 +72,30 @@ TEST_CASE("the silhouette image is the signed distance to the mask's outline") {
   CHECK(image.points.front() == frame.points.at<cv::Vec3f>(20, 30));
   CHECK(image.depthAt(40, 30) == 1.0f);
   CHECK(image.depthAt(0, 0) == 0.0f);
+  // Without a reading: unknown next to a reading off the mask (the occluder's rim, a dropout by
+  // the wall: the wall's row 44 lies within 4 px of row 47), past the sensor's range off the mask
+  // where there is none within 4 px; on the mask nothing.
+  CHECK(image.depthAt(58, 30) == 0.0f);
+  CHECK(image.depthAt(40, 47) == 0.0f);
+  CHECK(image.depthAt(40, 49) == std::numeric_limits<float>::infinity());
+  frame.depth.at<float>(30, 40) = 0.0f;
+  CHECK(bt::makeSilhouetteImage(frame, frame.mask, bt::MaskOutline::every_pixel, 2, 10).depthAt(40, 30) == 0.0f);
+  // A mask grown over depth never holds a pixel without a reading: one off it may be the object's.
+  const bt::SilhouetteImage over_depth = bt::makeSilhouetteImage(frame, frame.mask, bt::MaskOutline::where_depth_read, 2, 10);
+  CHECK(over_depth.depthAt(58, 30) == 0.0f);
+  CHECK(over_depth.depthAt(40, 49) == 0.0f);
+  CHECK(over_depth.depthAt(53, 30) == 2.0f);
+  CHECK(bt::makeSilhouetteImage(frame, frame.mask, bt::MaskOutline::none, 2, 10).empty());
 }
 
 TEST_CASE("the silhouette term counts a point outside the outline only where the frame sees past it") {
   // Past it: a reading farther than the point by three standard deviations of two readings'
   // difference. A nearer reading may be an occluder that the mask leaves out, one as near as the
-  // point the object itself where the mask misses it, and without one nothing is known.
+  // point the object itself where the mask misses it; without a reading off the mask within 4 px
+  // the frame saw nothing within the sensor's range there, next to one (a dropout, a rim) or beyond
+  // the depth camera's view nothing is known.
   const bt::RgbdFrame frame = rectangleFrame();
-  bt::SilhouetteImage t = bt::makeSilhouetteImage(frame, frame.mask, 1, 25);
+  bt::SilhouetteImage t = bt::makeSilhouetteImage(frame, frame.mask, bt::MaskOutline::every_pixel, 1, 25);
   t.points.clear();  // one direction only: s's points into t
   bt::SurfaceGrid grid;  // what the term reads of the grids: camera, step and noise scale
   grid.camera = kCamera;
@@ -93,17 +115,19 @@ TEST_CASE("the silhouette term counts a point outside the outline only where the
                                  // as the noise tells, which the mask misses: does not count
               at(36, 12, 0.98f),  // 7.5 px outside, a reading 15 mm farther: the frame saw past it, counts
               at(44, 12, 1.03f),  // outside, a reading 35 mm nearer: it may hide the point
-              at(40, 50, 1.0f),  // outside, no reading there
+              at(40, 50, 1.0f),  // 10.5 px outside, no reading there nor within 4 px: counts
+              at(58, 30, 1.0f),  // outside, on the occluder's rim without a reading: unknown
               at(64, 30, 1.0f),  // outside, behind the occluder
+              at(40, 64, 1.0f),  // outside, beyond the depth camera's view (and 5 px from its last row)
               at(90, 30, 1.0f)};  // beyond the silhouette image
   const bt::DenseSilhouette term;
   bt::PairSystem system;
   term.linearise(bt::DenseSilhouette::Input{grid, s, grid, t}, bt::SE3d(), bt::SE3d(), bt::TrivialLoss{}, 1.0, system);
-  CHECK(system.residuals == 2);  // (53, 30) and (36, 12)
+  CHECK(system.residuals == 3);  // (53, 30), (36, 12) and (40, 50)
   // Its weight: (reference spread / sigma)^2 x step / 4 at noise scale 1, step 1 (one camera: a depth
   // error moves the point along t's ray, not across the outline).
   const double weight = std::pow(bt::NoiseScale::referenceSpread() / term.sigma, 2) / 4.0;
-  CHECK(system.cost == doctest::Approx(weight * (3.5 * 3.5 + 7.5 * 7.5)));
+  CHECK(system.cost == doctest::Approx(weight * (3.5 * 3.5 + 7.5 * 7.5 + 10.5 * 10.5)));
 }
 
 TEST_CASE("a mask grown onto the background gives the silhouette none of the background's points") {
@@ -111,9 +135,9 @@ TEST_CASE("a mask grown onto the background gives the silhouette none of the bac
   // depth edge within the mask, farther than the nearest mask reading within 4 px by more than the
   // noise and a steep surface's rise, and are not the object's.
   bt::RgbdFrame frame = rectangleFrame();
-  const bt::SilhouetteImage exact = bt::makeSilhouetteImage(frame, frame.mask, 2, 10);
+  const bt::SilhouetteImage exact = bt::makeSilhouetteImage(frame, frame.mask, bt::MaskOutline::every_pixel, 2, 10);
   cv::dilate(frame.mask, frame.mask, cv::Mat::ones(7, 7, CV_8UC1));
-  const bt::SilhouetteImage grown = bt::makeSilhouetteImage(frame, frame.mask, 2, 10);
+  const bt::SilhouetteImage grown = bt::makeSilhouetteImage(frame, frame.mask, bt::MaskOutline::every_pixel, 2, 10);
   REQUIRE(grown.box.width > exact.box.width);  // the outline is the grown mask's
   CHECK(grown.points.size() == exact.points.size());
   for (const cv::Vec3f& p : grown.points) CHECK(p[2] == 1.0f);

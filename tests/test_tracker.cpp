@@ -241,7 +241,7 @@ TEST_CASE("keyframes carry intensity and silhouette images where a term of the e
   CHECK(without_term.keyframes()[0].image.empty());
   CHECK(without_term.keyframes()[0].silhouette.empty());
   CHECK(without_term.keyframes()[0].surface.cells.size() == first.surface.cells.size());
-  // Propagated masks end at the object's depth edges (PropagatedMasks::kOutlinesObject): silhouettes too.
+  // Propagated masks end at the object's depth edges (PropagatedMasks::kOutline): silhouettes too.
   PropagatedTracker propagated(camera);
   propagated.initialize(frame, f.T_cam_obj);
   CHECK_FALSE(propagated.keyframes()[0].image.empty());

@@ -440,12 +440,15 @@ class Tracker {
 
   /// A frame as a graph node on the tracker's grid, with an intensity image unless no term of the
   /// energy reads one, and a silhouette image where a term reads one and the masks outline the
-  /// object (GivenMasks::kOutlinesObject).
+  /// object (GivenMasks::kOutline).
   Keyframe keyframeOf(int id, const RgbdFrame& frame, const cv::Mat& mask, FrameFeatures features, const SE3d& T_cam_obj) const {
-    bool with_image = true, with_silhouette = requires { requires Masks::kOutlinesObject; };
+    bool with_image = true;
+    MaskOutline outline = MaskOutline::none;
+    if constexpr (requires { Masks::kOutline; }) outline = Masks::kOutline;
     if constexpr (requires { energy_.readsImages(); }) with_image = energy_.readsImages();
-    if constexpr (requires { energy_.readsSilhouettes(); }) with_silhouette = with_silhouette && energy_.readsSilhouettes();
-    return makeKeyframe(id, frame, mask, std::move(features), T_cam_obj, camera_, grid_step_, with_image, with_silhouette);
+    if constexpr (requires { energy_.readsSilhouettes(); })
+      if (!energy_.readsSilhouettes()) outline = MaskOutline::none;
+    return makeKeyframe(id, frame, mask, std::move(features), T_cam_obj, camera_, grid_step_, with_image, outline);
   }
 
   /// The current frame as a graph node at its coarse pose, with its features. Its grid and images

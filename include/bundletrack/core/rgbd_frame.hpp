@@ -1,5 +1,6 @@
 #pragma once
 
+#include <algorithm>
 #include <string>
 
 #include <opencv2/core.hpp>
@@ -24,6 +25,7 @@ struct RgbdFrame {
   cv::Mat normals;  ///< CV_32FC3, unit normals facing the camera; 0 where undefined
   NoiseScale noise;  ///< the depth sensor's noise, for tolerances on this frame's depths
   cv::Rect region;  ///< where depth, points and normals were computed
+  cv::Rect depth_view;  ///< where the depth camera sees: the bounding box of the raw depth's readings (empty: none)
 };
 
 /// One RGB-D observation as decoded, before preprocessing.
@@ -53,6 +55,33 @@ inline cv::Rect preprocessedRegion(const cv::Rect& region, cv::Size image) {
   return region.area() > 0 ? region & whole : whole;
 }
 
+/// The bounding box of a raw depth image's readings (metres, 0: none): where the depth camera
+/// sees. A depth image registered to the colour camera covers less of it where the depth camera's
+/// view is narrower (the shared sequences: no reading in 15-43 columns and 21-25 rows at each border);
+/// within the box a pixel without a reading saw nothing within the sensor's range (or a shadow, or
+/// a surface that returns no light). Rows are scanned from each end, then columns within them,
+/// each up to its first reading.
+inline cv::Rect depthCameraView(const cv::Mat& raw_depth) {
+  CV_Assert(raw_depth.type() == CV_32FC1);
+  const auto row_has_reading = [&](int y) {
+    const float* row = raw_depth.ptr<float>(y);
+    return std::any_of(row, row + raw_depth.cols, [](float z) { return z > 0.0f; });
+  };
+  int top = 0, bottom = raw_depth.rows;
+  while (top < bottom && !row_has_reading(top)) ++top;
+  while (bottom > top && !row_has_reading(bottom - 1)) --bottom;
+  if (top == bottom) return {};
+  const auto column_has_reading = [&](int x) {
+    for (int y = top; y < bottom; ++y)
+      if (raw_depth.at<float>(y, x) > 0.0f) return true;
+    return false;
+  };
+  int left = 0, right = raw_depth.cols;  // rows top and bottom - 1 hold a reading: both loops stop
+  while (!column_has_reading(left)) ++left;
+  while (!column_has_reading(right - 1)) --right;
+  return {left, top, right - left, bottom - top};
+}
+
 /// Filters the raw depth (metres) and derives points and normals, the depth tolerances widened by
 /// the sensor's noise. With a region (Tracker::regionOfInterest: the object's neighbourhood), only
 /// that part of the image is processed, from the raw depth within preprocessingReach of it, so the
@@ -62,7 +91,7 @@ inline RgbdFrame makeFrame(std::string name, cv::Mat color, const cv::Mat& raw_d
   const cv::Rect image({0, 0}, raw_depth.size());
   region = preprocessedRegion(region, image.size());
   const NoiseScale noise(settings.sensor, camera.fx);
-  RgbdFrame frame{std::move(name), std::move(color), {}, std::move(mask), {}, {}, noise, region};
+  RgbdFrame frame{std::move(name), std::move(color), {}, std::move(mask), {}, {}, noise, region, depthCameraView(raw_depth)};
   const cv::Rect around = grownWithin(region, preprocessingReach(settings), image.size());
   PinholeCameraf shifted = camera;  // pixel (u, v) of the image is (u - around.x, v - around.y) of the crop
   shifted.cx -= float(around.x);

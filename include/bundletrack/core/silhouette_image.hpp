@@ -10,6 +10,7 @@
 
 #include "bundletrack/core/angles.hpp"
 #include "bundletrack/core/bilinear.hpp"
+#include "bundletrack/core/image_region.hpp"
 #include "bundletrack/core/pixel.hpp"
 #include "bundletrack/core/rgbd_frame.hpp"
 
@@ -17,14 +18,20 @@ namespace bundletrack {
 
 /// A frame's silhouette of the object, as the silhouette term reads it: the signed distance to
 /// the mask's outline (pixels, positive outside, zero on the outline half a pixel beyond the
-/// outermost mask pixels) and its derivatives along u and v; the frame's depth there, which tells
+/// outermost mask pixels) and its derivatives along u and v; what the frame saw there, which tells
 /// a point that the object hides from an occluder in front of it; and the frame's own object
 /// points, every `step` pixels of the mask that have depth and are not behind a depth edge within
 /// it (with or without a normal: the outermost ones are what the outline constrains), in the
 /// camera frame.
 struct SilhouetteImage {
   cv::Mat samples;  ///< CV_32FC3, box.size(): signed distance and its derivatives along u and v
-  cv::Mat depth;  ///< CV_32FC1, box.size(): the frame's depth (metres, 0: none)
+  /// CV_32FC1, box.size(): what the frame saw at each pixel (metres): its reading; without one 0
+  /// (unknown: a dropout, a shadow, the rim that the sensor and the depth filter's erosion take off
+  /// a surface, an occluder that returns no light), except off a MaskOutline::every_pixel mask
+  /// where no pixel off the mask within kSilhouetteEdgeRadius has a reading either, within the
+  /// depth camera's view and the preprocessed region: infinity, nothing within the sensor's range
+  /// (a far background), past every point.
+  cv::Mat depth;
   cv::Rect box;  ///< of the full image: the mask's bounding box grown by the margin
   std::vector<cv::Vec3f> points;  ///< camera frame
 
@@ -44,11 +51,24 @@ struct SilhouetteImage {
     return x >= 0 && y >= 0 && x < box.width && y < box.height && samples.at<cv::Vec3f>(y, x)[0] < -2.0f;
   }
 
-  /// The frame's depth at full-resolution pixel (u, v) (0: none, or outside the box).
+  /// What the frame saw at full-resolution pixel (u, v) (`depth`; 0: unknown, or outside the box).
   float depthAt(int u, int v) const {
     const int x = u - box.x, y = v - box.y;
     return x >= 0 && y >= 0 && x < box.width && y < box.height ? depth.at<float>(y, x) : 0.0f;
   }
+};
+
+/// What a frame's mask says of the object's outline, for its silhouette image (a mask source's
+/// kOutline; without one it makes none).
+enum class MaskOutline {
+  none,  ///< the mask is not the object's outline (a search region): no silhouette image
+  /// The outline where depth was read: a pixel off the mask without a reading may be the object's
+  /// (a mask grown over depth-continuous pixels, PropagatedMasks, never holds one).
+  where_depth_read,
+  /// The outline at every pixel, read or not: a segmentation of the colour image (GivenMasks); a
+  /// pixel off the mask is not the object's, and where neither it nor any pixel off the mask
+  /// nearby has a reading the frame saw past every point there.
+  every_pixel,
 };
 
 /// A mask that bleeds over the object's outline reads what lies behind it there. Its points are the
@@ -59,12 +79,14 @@ struct SilhouetteImage {
 constexpr int kSilhouetteEdgeRadius = 4;
 constexpr double kSilhouetteEdgeSlopeDeg = 75.0;
 
-/// The silhouette image of `frame` under `mask` over the mask's bounding box grown by `margin`
-/// pixels, its points every `step` pixels (empty without a mask pixel). Distances: exact Euclidean
-/// (cv::DIST_MASK_PRECISE) from the pixel centres; derivatives: the 3x3 Sobel operator over 8.
-inline SilhouetteImage makeSilhouetteImage(const RgbdFrame& frame, const cv::Mat& mask, int step, int margin) {
+/// The silhouette image of `frame` under `mask`, an outline of kind `outline`, over the mask's
+/// bounding box grown by `margin` pixels, its points every `step` pixels (empty without a mask
+/// pixel, or for MaskOutline::none). Distances: exact Euclidean (cv::DIST_MASK_PRECISE) from the
+/// pixel centres; derivatives: the 3x3 Sobel operator over 8.
+inline SilhouetteImage makeSilhouetteImage(const RgbdFrame& frame, const cv::Mat& mask, MaskOutline outline, int step,
+                                           int margin) {
   SilhouetteImage image;
-  if (mask.empty()) return image;
+  if (mask.empty() || outline == MaskOutline::none) return image;
   const cv::Rect object = cv::boundingRect(mask);
   if (object.area() == 0) return image;
   image.box = cv::Rect(object.x - margin, object.y - margin, object.width + 2 * margin, object.height + 2 * margin) &
@@ -83,12 +105,25 @@ inline SilhouetteImage makeSilhouetteImage(const RgbdFrame& frame, const cv::Mat
   cv::Sobel(distance, d_v, CV_32F, 0, 1, 3, 1.0 / 8.0, 0.0, cv::BORDER_REPLICATE);
   cv::merge(std::vector<cv::Mat>{distance, d_u, d_v}, image.samples);
   frame.depth(image.box).copyTo(image.depth);
-  // The nearest reading on the mask within kSilhouetteEdgeRadius pixels of each pixel of the box.
-  cv::Mat on_mask(inside.size(), CV_32FC1, cv::Scalar(std::numeric_limits<float>::max()));
-  image.depth.copyTo(on_mask, inside & (image.depth > 0.0f));
-  cv::Mat nearest;
-  const int window = 2 * kSilhouetteEdgeRadius + 1;
-  cv::erode(on_mask, nearest, cv::Mat::ones(window, window, CV_8UC1));
+  // Over the box and kSilhouetteEdgeRadius pixels beyond it: the nearest reading on the mask within
+  // that radius of each pixel, and whether one off the mask lies within it.
+  const cv::Rect around = grownWithin(image.box, kSilhouetteEdgeRadius, mask.size());
+  const cv::Mat depth_around = frame.depth(around), on_mask = mask(around) != 0, readings = depth_around > 0.0f;
+  const cv::Mat window = cv::Mat::ones(2 * kSilhouetteEdgeRadius + 1, 2 * kSilhouetteEdgeRadius + 1, CV_8UC1);
+  const cv::Rect box_in_around = image.box - around.tl();
+  cv::Mat nearest(around.size(), CV_32FC1, cv::Scalar(std::numeric_limits<float>::max())), reading_off_mask_nearby;
+  depth_around.copyTo(nearest, on_mask & readings);
+  cv::erode(nearest, nearest, window);
+  nearest = nearest(box_in_around);
+  if (outline == MaskOutline::every_pixel) {
+    cv::dilate(~on_mask & readings, reading_off_mask_nearby, window);
+    reading_off_mask_nearby = reading_off_mask_nearby(box_in_around);
+    const cv::Rect known = (frame.depth_view & preprocessedRegion(frame.region, mask.size())) - image.box.tl();
+    for (int y = 0; y < inside.rows; ++y)
+      for (int x = 0; x < inside.cols; ++x)
+        if (!inside.at<uchar>(y, x) && !reading_off_mask_nearby.at<uchar>(y, x) && known.contains({x, y}))
+          image.depth.at<float>(y, x) = std::numeric_limits<float>::infinity();  // no reading here either
+  }
   const double rise_per_metre = kSilhouetteEdgeRadius * std::tan(radians(kSilhouetteEdgeSlopeDeg)) / frame.noise.focalLength();
   const int first_u = (object.x + step - 1) / step * step, first_v = (object.y + step - 1) / step * step;
   for (int v = first_v; v < object.y + object.height; v += step)

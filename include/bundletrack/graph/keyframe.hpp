@@ -31,18 +31,18 @@ constexpr int kSilhouetteMargin = 16;
 /// The keyframe of `frame` under `mask`, its surface sampled every `grid_step` pixels. With
 /// `with_image` (an energy term reads it) its intensity image reaches two grid steps beyond the
 /// mask, as far as a point associated with the surface (within one cell of it) can project, and
-/// holds the intensity at the surface's cells. With `with_silhouette` (an energy term reads it and
-/// the mask is the object's outline) its silhouette image reaches kSilhouetteMargin pixels and two
-/// grid steps beyond the mask.
+/// holds the intensity at the surface's cells. Unless `outline` is MaskOutline::none (no energy
+/// term reads one, or the mask is not the object's outline) its silhouette image reaches
+/// kSilhouetteMargin pixels and two grid steps beyond the mask.
 inline Keyframe makeKeyframe(int id, const RgbdFrame& frame, const cv::Mat& mask, FrameFeatures features,
                              const SE3d& T_cam_obj, const PinholeCameraf& camera, int grid_step, bool with_image = true,
-                             bool with_silhouette = true) {
+                             MaskOutline outline = MaskOutline::every_pixel) {
   Keyframe keyframe{id, frame.name, T_cam_obj, std::move(features), sampleSurface(frame, mask, camera, grid_step), {}, {}};
   if (with_image) {
     keyframe.image = makeIntensityImage(frame.color, mask, 2 * grid_step);
     keyframe.image.sampleCells(keyframe.surface);
   }
-  if (with_silhouette) keyframe.silhouette = makeSilhouetteImage(frame, mask, grid_step, kSilhouetteMargin + 2 * grid_step);
+  keyframe.silhouette = makeSilhouetteImage(frame, mask, outline, grid_step, kSilhouetteMargin + 2 * grid_step);
   return keyframe;
 }
 

@@ -4,6 +4,7 @@
 
 #include "bundletrack/core/error.hpp"
 #include "bundletrack/core/image_region.hpp"
+#include "bundletrack/core/silhouette_image.hpp"
 #include "bundletrack/masks/mask_source.hpp"
 
 namespace bundletrack {
@@ -11,9 +12,10 @@ namespace bundletrack {
 /// Masks that come with the data (the frame's own mask, e.g. from masks/<name>.png): the same
 /// mask whatever the tracker knows.
 struct GivenMasks {
-  /// Each mask is the object's outline as the data sees it, independent of any pose: the
-  /// silhouette term may read it (a mask source without this flag makes no silhouettes).
-  static constexpr bool kOutlinesObject = true;
+  /// Each mask is the object's outline as the data sees it, independent of any pose, at every
+  /// pixel whether depth was read there or not (a segmentation of the colour image): the
+  /// silhouette term may read it (a mask source without kOutline makes no silhouettes).
+  static constexpr MaskOutline kOutline = MaskOutline::every_pixel;
 
   /// The given mask's bounding box; the whole image without one (track() then reports it).
   cv::Rect regionOfInterest(cv::Size image, const cv::Mat& given_mask, const ObservedObject&,

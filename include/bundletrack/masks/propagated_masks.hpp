@@ -9,6 +9,7 @@
 
 #include "bundletrack/core/error.hpp"
 #include "bundletrack/core/image_region.hpp"
+#include "bundletrack/core/silhouette_image.hpp"
 #include "bundletrack/core/surface_grid.hpp"
 #include "bundletrack/masks/colour_likelihood.hpp"
 #include "bundletrack/masks/depth_segments.hpp"
@@ -57,7 +58,8 @@ struct PropagatedMaskSettings {
 /// told apart by colour within the plane's noise). A mask that comes out empty
 /// means the object is not where the pose says: the tracker reports the frame lost.
 /// Where the object stands out from what lies behind it, the mask's outline is that depth edge,
-/// the data's and not the pose's, so the silhouette term reads it (kOutlinesObject); elsewhere
+/// the data's and not the pose's, so the silhouette term reads it (kOutline); it holds only pixels
+/// with depth, so one off it without a reading may still be the object's; elsewhere
 /// the mask ends where the growth or the hull stops it, on a surface continuous with the object,
 /// and there the term counts nothing: it weighs a point outside a mask only where that frame saw
 /// past it (DenseSilhouette). Without it a textureless chair 3 m away slid along its seat and
@@ -65,7 +67,7 @@ struct PropagatedMaskSettings {
 class PropagatedMasks {
  public:
   using Settings = PropagatedMaskSettings;
-  static constexpr bool kOutlinesObject = true;
+  static constexpr MaskOutline kOutline = MaskOutline::where_depth_read;
   /// Colour tells the object from its support where at least this share of the first mask and at
   /// most the rest of its ring look like the object (a two-class rule right on 80 % of each).
   static constexpr double kColourSeparates = 0.8;

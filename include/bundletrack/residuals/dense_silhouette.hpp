@@ -24,10 +24,12 @@ namespace bundletrack {
 /// deviations of two readings' difference. A nearer reading may be an occluder that the mask
 /// leaves out (a hand, a support it stands on or in), one within the noise of the point the
 /// object itself where t's mask misses it (a segmentation's rim, a mask moved by the depth-to-colour
-/// registration); without a reading nothing says the object is not there (a depth camera's
-/// narrower view, a shadow); nor does a point that lands outside t's silhouette image count.
+/// registration). Without a reading nothing says the object is not there (a dropout, a shadow, a
+/// rim the depth filter took off, a depth camera's narrower view), unless SilhouetteImage::depth
+/// says t saw past it: a given mask's background with no reading within a few pixels, beyond the
+/// sensor's range. Nor does a point that lands outside t's silhouette image count.
 /// Both directions of an edge are summed. The masks must end at the object's outline where they
-/// end before a farther surface (kOutlinesObject: given masks, and propagated ones, which end
+/// end before a farther surface (kOutline: given masks, and propagated ones, which end
 /// there at the depth edge).
 /// What it holds: the outline pins the motion that the surface lets slide -- a box seen on two
 /// faces slides along their common edge, a plane in its own plane -- where there is no texture.
@@ -93,8 +95,8 @@ struct DenseSilhouette {
       const double u = fx * q.x() / q.z() + cx, v = fy * q.y() / q.z() + cy;
       double distance = 0.0, d_u = 0.0, d_v = 0.0;
       if (t.deepInside(u, v) || !t.sample(u, v, distance, d_u, d_v) || distance <= 0.0) continue;
-      // t must have seen past the point there: without a reading nothing says the object is not
-      // there, a nearer one may be an occluder, one as near the object where t's mask misses it.
+      // t must have seen past the point there: a nearer reading may be an occluder, one as near the
+      // object where t's mask misses it; where nothing is known (0) nothing says the object is not there.
       const float seen = t.depthAt(roundToPixel(u), roundToPixel(v));
       if (seen <= 0.0f || seen <= q.z() + occlusion_margin) continue;
       const Eigen::Vector3d g = imageGradientAt(q, fx, fy, d_u, d_v);
