@@ -17,7 +17,7 @@ int main(int argc, char** argv) {
   bt::synth::SyntheticSequenceSettings settings;
   std::string out, shape = "box", motion = "handheld", sensor = "structured_light", layout_name = "ycbineoat", mask_error = "none";
   std::vector<int> out_of_view;
-  bool no_noise = false, labels = false;
+  bool no_noise = false, no_shadow = false, labels = false;
   bt::examples::CommandLine command_line(
       "Renders a synthetic RGB-D sequence with exact ground truth (annotated poses, masks, model) in the\n"
       "YCBInEOAT or the TUM RGB-D layout.",
@@ -51,11 +51,13 @@ int main(int argc, char** argv) {
   command_line.add_option("--motion-blur", settings.motion_blur_samples, "average the colour over N instants of the exposure (1: off)")
       ->capture_default_str()
       ->check(bt::examples::wholeIn(1, 1000));
-  command_line.add_option("--sensor", sensor, "depth noise of structured_light (Kinect v1, Asus Xtion) | active_stereo\n"
-                                              "(RealSense D4xx) | time_of_flight (Azure Kinect) (bundletrack::DepthNoise)")
+  command_line.add_option("--sensor", sensor, "depth noise and shadow of structured_light (Kinect v1, Asus Xtion) |\n"
+                                              "active_stereo (RealSense D4xx) | time_of_flight (Azure Kinect, no shadow)\n"
+                                              "(bundletrack::DepthNoise, synth::SensorSettings::shadow)")
       ->capture_default_str()
       ->check(CLI::IsMember({"structured_light", "active_stereo", "time_of_flight"}));
-  command_line.add_flag("--no-noise", no_noise, "perfect sensor: no depth noise, quantisation, dropouts or colour noise");
+  command_line.add_flag("--no-noise", no_noise, "perfect sensor: no depth noise, quantisation, shadow, dropouts or colour noise");
+  command_line.add_flag("--no-shadow", no_shadow, "no shadow: every surface the depth camera sees has a reading (before dropouts)");
   command_line.add_option("--objects", settings.objects, "1 | 2 | 3 objects, each carried by its own hand: beside the --shape the first\n"
                                                          "of box, cylinder, mug it is not, passing in front of and behind it; their\n"
                                                          "masks, poses and models go to masks/<shape>/, annotated_poses/<shape>/ and\n"
@@ -84,6 +86,7 @@ int main(int argc, char** argv) {
   if (sensor == "active_stereo") settings.sensor.depth_noise = bt::DepthNoise::activeStereo();
   else if (sensor == "time_of_flight") settings.sensor.depth_noise = bt::DepthNoise::timeOfFlight();
   if (no_noise) settings.sensor = bt::synth::SensorSettings::perfect();
+  if (no_shadow) settings.sensor.shadow = false;
   const std::map<std::string, bt::synth::MaskError> mask_errors = {{"none", bt::synth::MaskError::None},
                                                                     {"dilate", bt::synth::MaskError::Dilated},
                                                                     {"erode", bt::synth::MaskError::Eroded},

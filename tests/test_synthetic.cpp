@@ -211,6 +211,45 @@ TEST_CASE("the synthetic sensor's depth spreads as its preset's sigma(z) at 0.5,
   }
 }
 
+TEST_CASE("a triangulating sensor's shadow: what its second viewpoint cannot see beside a nearer surface") {
+  // A step: the right half of the image at 1 m, the left half at 2 m. The second viewpoint (the
+  // projector) sits 7.5 cm along +x; a pixel of the far half is hidden where the ray from there to
+  // its point crosses z = 1 m within the near half (pixel centres from column 320 on).
+  const double fx = kCamera.fx, cx = kCamera.cx, baseline = 0.075, near = 1.0, far = 2.0;
+  cv::Mat depth(kSize, CV_32FC1, cv::Scalar(far));
+  depth.colRange(320, kSize.width).setTo(near);
+  const cv::Mat shadowed = synth::shadowedPixels(depth, fx, baseline);
+  const double near_left = (320 - cx) * near / fx, near_right = (kSize.width - 1 - cx) * near / fx;
+  int hidden = 0, wrong = 0;
+  for (int u = 0; u < kSize.width; ++u) {
+    const double z = depth.at<float>(0, u), x = (u - cx) * z / fx;
+    const double x_at_near = baseline + (x - baseline) * near / z;  // where the ray from the projector crosses z = near
+    const bool expected = z > near && x_at_near >= near_left && x_at_near <= near_right;
+    hidden += expected;
+    for (int v = 0; v < kSize.height; ++v) wrong += (shadowed.at<uchar>(v, u) != 0) != expected;
+  }
+  CHECK(wrong == 0);
+  // The band is fx baseline (1 / near - 1 / far) = 22.5 px wide: columns 298-319.
+  CHECK(hidden == 22);
+  CHECK(cv::countNonZero(synth::shadowedPixels(depth, fx, 0.0)) == 0);
+  // The sensor reads nothing there and everything else: structured light (a 7.5 cm baseline)
+  // casts it, time of flight does not.
+  synth::RenderBuffers clean{depth, cv::Mat(kSize, CV_32SC1, cv::Scalar(0)), cv::Mat(kSize, CV_32FC3, cv::Scalar::all(0.5)),
+                             cv::Mat(kSize, CV_32FC3, cv::Scalar(0.0, 0.0, -1.0))};
+  for (const bt::DepthNoise& preset : {bt::DepthNoise::structuredLight(), bt::DepthNoise::timeOfFlight()}) {
+    synth::SensorSettings sensor = perfectSensor();
+    sensor.depth_noise = preset;
+    sensor.shadow = true;
+    cv::Mat read, color;
+    synth::applySensorModel(clean, kCamera, sensor, 3, read, color);
+    const cv::Mat none = read == 0.0f;
+    CHECK(cv::countNonZero(none) == (synth::triangulates(preset) ? hidden * kSize.height : 0));
+    CHECK(cv::countNonZero(none & ~shadowed) == 0);
+  }
+  depth.setTo(near);
+  CHECK(cv::countNonZero(synth::shadowedPixels(depth, fx, baseline)) == 0);  // a plane facing the camera: none
+}
+
 TEST_CASE("the synthetic distance option places the camera that far from the object, hand-held and orbiting") {
   for (const auto motion : {synth::Motion::HandHeld, synth::Motion::CameraOrbit}) {
     for (const double distance : {0.5, 3.0}) {

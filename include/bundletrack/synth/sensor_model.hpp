@@ -1,6 +1,7 @@
 #pragma once
 
 #include <cmath>
+#include <limits>
 #include <random>
 
 #include <opencv2/core.hpp>
@@ -12,10 +13,18 @@
 namespace bundletrack::synth {
 
 /// A depth sensor and a colour camera: the depth noise of one of the library's presets
-/// (DepthNoise: structured light by default, Kinect v1 measurements), dropouts at depth edges and
-/// grazing angles, colour noise. Every effect can be switched off by zeroing its parameter.
+/// (DepthNoise: structured light by default, Kinect v1 measurements), the shadow a triangulating
+/// sensor's second viewpoint leaves beside near surfaces, dropouts at depth edges and grazing
+/// angles, colour noise. Every effect can be switched off (its parameter zero, `shadow` false).
 struct SensorSettings {
   DepthNoise depth_noise = DepthNoise::structuredLight();
+  /// The shadow of a triangulating sensor (one whose noise has a disparity term: structured light,
+  /// active stereo): the viewpoint it also needs to see a point from lies depth_noise.baseline
+  /// along the camera's +x -- the projector of a structured-light camera (Kinect v1: 7.5 cm), the
+  /// second imager of an active-stereo one (D435: 5 cm; depth in the left imager's frame) -- and
+  /// a surface hidden from there has no reading: a band beside the left side of a near object on
+  /// the surface behind it (shadowedPixels). Time of flight, lit from beside its lens, has none.
+  bool shadow = true;
   double min_range = 0.2, max_range = 4.0;  ///< metres; outside: no reading
   double edge_jump = 0.01;  ///< metres; a 4-neighbour this much farther or closer marks a depth edge
   double edge_dropout = 0.6;  ///< probability that a depth-edge pixel has no reading
@@ -28,10 +37,37 @@ struct SensorSettings {
     SensorSettings s;
     s.depth_noise = DepthNoise();
     s.edge_dropout = s.random_dropout = s.color_noise = 0.0;
+    s.shadow = false;
     s.grazing_angle_deg = 90.0;
     return s;
   }
 };
+
+/// Whether a sensor with this noise triangulates (its noise has a disparity term), and so casts
+/// a shadow (SensorSettings::shadow).
+inline bool triangulates(const DepthNoise& noise) { return noise.subpixel > 0.0 || noise.disparity_step > 0.0; }
+
+/// Pixels the second viewpoint of a triangulating sensor (`baseline` metres along the camera's
+/// +x, focal length `fx`) cannot see in a depth image (CV_32FC1, metres, 0: nothing there), as a
+/// mask: seen from there, pixel u of depth z lies at u - fx baseline / z, and a pixel is hidden
+/// where a pixel to its right, nearer, lands at or left of it (one pass per row from the right,
+/// keeping the leftmost landing). A step from z_near to z_far leaves a band of
+/// fx baseline (1 / z_near - 1 / z_far) pixels.
+inline cv::Mat shadowedPixels(const cv::Mat& depth, double fx, double baseline) {
+  cv::Mat shadowed(depth.size(), CV_8UC1, cv::Scalar(0));
+  if (baseline <= 0.0) return shadowed;
+  for (int v = 0; v < depth.rows; ++v) {
+    double leftmost = std::numeric_limits<double>::infinity();
+    for (int u = depth.cols - 1; u >= 0; --u) {
+      const double z = depth.at<float>(v, u);
+      if (z <= 0.0) continue;
+      const double landing = u - fx * baseline / z;
+      if (landing > leftmost) shadowed.at<uchar>(v, u) = 255;
+      else leftmost = landing;
+    }
+  }
+  return shadowed;
+}
 
 /// Turns a clean render into a sensor reading: depth in metres (0 = no reading), BGR 8-bit.
 /// Deterministic for a given seed.
@@ -42,11 +78,13 @@ inline void applySensorModel(const RenderBuffers& clean, const PinholeCamerad& c
   std::uniform_real_distribution<double> uniform(0.0, 1.0);
   const double cos_grazing = std::cos(radians(s.grazing_angle_deg));
   depth = cv::Mat(clean.depth.size(), CV_32FC1, cv::Scalar(0));
+  const double shadow_baseline = s.shadow && triangulates(s.depth_noise) ? s.depth_noise.baseline : 0.0;
+  const cv::Mat shadowed = shadowedPixels(clean.depth, camera.fx, shadow_baseline);
   for (int v = 0; v < depth.rows; ++v) {
     for (int u = 0; u < depth.cols; ++u) {
       const double noise = gauss(rng), dropout = uniform(rng);  // drawn for every pixel: stable streams
       const double z = clean.depth.at<float>(v, u);
-      if (z <= s.min_range || z >= s.max_range || dropout < s.random_dropout) continue;
+      if (z <= s.min_range || z >= s.max_range || dropout < s.random_dropout || shadowed.at<uchar>(v, u)) continue;
       bool edge = false;
       for (const auto& [dv, du] : {std::pair{0, 1}, {0, -1}, {1, 0}, {-1, 0}}) {
         const int vv = v + dv, uu = u + du;
