@@ -264,25 +264,27 @@ class Tracker {
   }
 
   /// Paper IV-B: RANSAC with the last good frame; after lost frames, the candidates of
-  /// reacquisitionCandidates. Where no pose is found with the last frame, the detected keypoints
-  /// are also kept aside for refineFromFollowing.
+  /// reacquisitionCandidates. Where no pose is found with the last frame, the graph starts from
+  /// the last good pose with nothing but the surface behind it, and is verified as such (as by
+  /// trackBySurface, which may have refused the same graph already); the detected keypoints are
+  /// also kept aside for refineFromFollowing.
   bool estimateCoarsePose(FrameContext& ctx) {
     const KeypointFrame& last = last_->keypoints;
     PairRegistration from_last = registerPair(last.features, ctx.features, std::nullopt, &clock_);
     ctx.result.matches = int(from_last.matches.size());
     ctx.result.inliers = int(from_last.inliers.size());
     if (ctx.recovering) return reacquisitionCandidates(ctx, std::move(from_last));
-    CoarseEstimate coarse;
-    coarse.found = coarse.from_last = ctx.result.inliers >= settings_.min_inliers;
-    if (!coarse.found && ctx.followed_reserve) ctx.detected_kept = ctx.features;
-    coarse.T_cam_obj = coarse.found ? from_last.T_second_first * last.T_cam_obj : last_->T_cam_obj;
-    if (coarse.found) coarse.last_inliers = std::move(from_last.inliers);
-    ctx.candidates.push_back(std::move(coarse));
+    if (ctx.result.inliers < settings_.min_inliers) {
+      if (ctx.followed_reserve) ctx.detected_kept = ctx.features;
+      ctx.candidates.push_back({last_->T_cam_obj, false, false, Evidence::SurfaceOnly, {}});
+      return true;
+    }
+    ctx.candidates.push_back({from_last.T_second_first * last.T_cam_obj, true, true, Evidence::Features, std::move(from_last.inliers)});
     // A registration on fewer inliers than chance can gather may be wrong (a small mug 3 m away:
     // 8 of 8 matches kept, turned by 140 degrees): where the keyframes' surfaces refuse the graph
     // from it, the graph from the last good pose is tried on the surface's evidence before
     // RANSAC's pose is reported.
-    if (ctx.candidates.back().found && ctx.result.inliers < settings_.recovery_min_inliers)
+    if (ctx.result.inliers < settings_.recovery_min_inliers)
       ctx.candidates.push_back({last_->T_cam_obj, false, false, Evidence::SurfaceOnly, {}});
     return true;
   }
@@ -440,7 +442,7 @@ class Tracker {
 
   /// A frame as a graph node on the tracker's grid, with an intensity image unless no term of the
   /// energy reads one, and a silhouette image where a term reads one and the masks outline the
-  /// object (GivenMasks::kOutline).
+  /// object (the mask source's kOutline).
   Keyframe keyframeOf(int id, const RgbdFrame& frame, const cv::Mat& mask, FrameFeatures features, const SE3d& T_cam_obj) const {
     bool with_image = true;
     MaskOutline outline = MaskOutline::none;

@@ -119,10 +119,9 @@ inline SilhouetteImage makeSilhouetteImage(const RgbdFrame& frame, const cv::Mat
     cv::dilate(~on_mask & readings, reading_off_mask_nearby, window);
     reading_off_mask_nearby = reading_off_mask_nearby(box_in_around);
     const cv::Rect known = (frame.depth_view & preprocessedRegion(frame.region, mask.size())) - image.box.tl();
-    for (int y = 0; y < inside.rows; ++y)
-      for (int x = 0; x < inside.cols; ++x)
-        if (!inside.at<uchar>(y, x) && !reading_off_mask_nearby.at<uchar>(y, x) && known.contains({x, y}))
-          image.depth.at<float>(y, x) = std::numeric_limits<float>::infinity();  // no reading here either
+    const cv::Rect seen = known & cv::Rect({0, 0}, inside.size());
+    const cv::Mat far = ~inside(seen) & ~reading_off_mask_nearby(seen);  // no reading here either
+    image.depth(seen).setTo(std::numeric_limits<float>::infinity(), far);
   }
   const double rise_per_metre = kSilhouetteEdgeRadius * std::tan(radians(kSilhouetteEdgeSlopeDeg)) / frame.noise.focalLength();
   const int first_u = (object.x + step - 1) / step * step, first_v = (object.y + step - 1) / step * step;
