@@ -7,7 +7,7 @@
 # where the object leaves the view). With --before, a
 # second build's tracker runs on the very same sequences and its columns stand beside.
 #
-# The design is sparse (56 synthetic cells, not the 144 of the full product), chosen so that each
+# The design is sparse (59 synthetic cells, not the 144 of the full product), chosen so that each
 # factor varies with the others held at their usual value:
 #   A  distance {0.5, 1, 2, 3 m} x object {mug 0.10 m, box 0.20 m, chair 0.70 m} x {textured,
 #      textureless}, structured light, normal speed (no chair at 0.5 m: it would not fit the view);
@@ -23,6 +23,11 @@
 #      the box at 1 m, the textureless mug at 1 m, the textureless box and chair at 3 m, the
 #      textureless chair at 2.5 m under active stereo, the box behind the occluder at 2 m, the mug
 #      at 3 m; and the shared sequences (real_*_propagated).
+#   G  other image sizes and fields of view (bundletrack_synth --resolution, --focal), 1280x720: 87
+#      degrees wide (focal 674 px, a RealSense D435's depth at 720p) with the box at 1 m under active
+#      stereo, 93 degrees (605 px, an Azure Kinect's 720p colour camera, depth mapped to it) with the
+#      textureless chair at 3 m under time of flight, and the 640x480 camera's 56 degrees at twice
+#      its pixels (1200 px) with the mug at 1 m.
 #
 # Usage: bash bench/accuracy_matrix.sh BUILD_DIR OUT_DIR [--before BUILD_DIR [--before-label TEXT]]
 #        [--config FILE] [--data DIR] [--frames N] [--markdown FILE]
@@ -91,6 +96,9 @@ for cell in "box_1m|--shape box --size 0.20 --distance 1" "mug_1m_textureless|--
   "box_2m_occluder|--shape box --size 0.20 --distance 2 --occluder" "mug_3m|--shape mug --size 0.10 --distance 3"; do
   cells+=("F_${cell%%|*}_propagated|${cell#*|}|--propagate-masks")
 done
+cells+=("G_box_1m_active_stereo_720p|--shape box --size 0.20 --distance 1 --sensor active_stereo --resolution 1280x720 --focal 674")
+cells+=("G_chair_3m_textureless_time_of_flight_720p|--shape chair --size 0.70 --distance 3 --textureless --sensor time_of_flight --resolution 1280x720 --focal 605")
+cells+=("G_mug_1m_720p|--shape mug --size 0.10 --distance 1 --resolution 1280x720")
 
 tool() {  # build name -> path of the build's executable
   if [ -x "$1/bin/$2" ]; then echo "$1/bin/$2"; else echo "$1/$2"; fi
@@ -187,8 +195,8 @@ out = ["# Accuracy stress matrix", "",
        "the object is seen (`bundletrack_eval --in-view`), which differ from the whole sequence's only",
        "where the object leaves the view (D_*_out_of_view). Cell names: A distance x object x texture,",
        "B sensor, C fast motion, D occlusion and out of view, E masks 3 px off the outline, F and",
-       "real_*_propagated: the first frame's mask alone (--propagate-masks); see the script's header",
-       "for the design."]
+       "real_*_propagated: the first frame's mask alone (--propagate-masks), G 1280x720 images at",
+       "other fields of view; see the script's header for the design."]
 if with_before:
     out.append(f"The before columns: {before_label}, on the same sequences.")
 out.append("")

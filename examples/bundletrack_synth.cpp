@@ -16,6 +16,8 @@ namespace bt = bundletrack;
 int main(int argc, char** argv) {
   bt::synth::SyntheticSequenceSettings settings;
   std::string out, shape = "box", motion = "handheld", sensor = "structured_light", layout_name = "ycbineoat", mask_error = "none";
+  std::string resolution = "640x480";
+  double focal = 0.0;
   std::vector<int> out_of_view;
   bool no_noise = false, no_shadow = false, labels = false;
   bt::examples::CommandLine command_line(
@@ -56,6 +58,14 @@ int main(int argc, char** argv) {
                                               "(bundletrack::DepthNoise, synth::SensorSettings::shadow)")
       ->capture_default_str()
       ->check(CLI::IsMember({"structured_light", "active_stereo", "time_of_flight"}));
+  command_line.add_option("--resolution", resolution, "the images' width x height in pixels, e.g. 1280x720 (the principal point at\n"
+                                                      "their centre)")
+      ->type_name("WxH")
+      ->capture_default_str();
+  command_line.add_option("--focal", focal, "the focal length in pixels (default 600 per 640 px of width: the same\n"
+                                            "horizontal field of view, 56 degrees, at any width)")
+      ->type_name("PX")
+      ->check(bt::examples::positive());
   command_line.add_flag("--no-noise", no_noise, "perfect sensor: no depth noise, quantisation, shadow, dropouts or colour noise");
   command_line.add_flag("--no-shadow", no_shadow, "no shadow: every surface the depth camera sees has a reading (before dropouts)");
   command_line.add_option("--objects", settings.objects, "1 | 2 | 3 objects, each carried by its own hand: beside the --shape the first\n"
@@ -79,6 +89,14 @@ int main(int argc, char** argv) {
       ->capture_default_str()
       ->check(CLI::IsMember({"ycbineoat", "tum"}));
   command_line.parseOrExit(argc, argv);
+  int width = 0, height = 0;
+  char rest = 0;
+  if (std::sscanf(resolution.c_str(), "%dx%d%c", &width, &height, &rest) != 2 || width < 64 || height < 64 || width > 8192 ||
+      height > 8192)
+    command_line.fail("--resolution " + resolution + ": expected WIDTHxHEIGHT in pixels, each from 64 to 8192 (e.g. 1280x720)");
+  settings.image_size = cv::Size(width, height);
+  const double f = focal > 0.0 ? focal : 600.0 * width / 640.0;
+  settings.camera = bt::PinholeCamerad{f, f, 0.5 * (width - 1), 0.5 * (height - 1)};
   const std::map<std::string, bt::synth::Shape> shapes = {{"box", bt::synth::Shape::Box}, {"cylinder", bt::synth::Shape::Cylinder},
                                                           {"mug", bt::synth::Shape::Mug}, {"chair", bt::synth::Shape::Chair}};
   settings.shape = shapes.at(shape);

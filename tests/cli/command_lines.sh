@@ -11,7 +11,7 @@ rm -rf "$work" && mkdir -p "$work"
 
 # --help: exit 0, every option listed.
 "$synth" --help > "$work/help.txt" || fail "bundletrack_synth --help: exit $?"
-for option in --out --frames --shape --size --distance --sensor --out-of-view --objects --labels --seed --layout; do
+for option in --out --frames --shape --size --distance --sensor --resolution --focal --out-of-view --objects --labels --seed --layout; do
   grep -q -- "$option" "$work/help.txt" || fail "bundletrack_synth --help does not list $option"
 done
 "$track" --help > "$work/help.txt" || fail "bundletrack_track --help: exit $?"
@@ -44,6 +44,20 @@ refused "--frames" "$synth" --out "$work/never" --frames 3 --frames 4
 refused "--colour" "$synth" --out "$work/never" --colour red
 refused "--out is required" "$synth" --frames 3
 refused "--labels needs --objects 2 or 3" "$synth" --out "$work/never" --labels
+refused "--resolution 1280x: expected WIDTHxHEIGHT in pixels" "$synth" --out "$work/never" --resolution 1280x
+refused "--resolution 1280x720x3: expected WIDTHxHEIGHT" "$synth" --out "$work/never" --resolution 1280x720x3
+refused "--resolution 32x24: expected WIDTHxHEIGHT in pixels, each from 64 to 8192" "$synth" --out "$work/never" --resolution 32x24
+refused "--focal: expects a number > 0, got '0'" "$synth" --out "$work/never" --focal 0
+
+# --resolution and --focal: the images' size (a PNG's IHDR holds width and height at bytes 16-23)
+# and cam_K.txt's intrinsics, the principal point at the centre.
+"$synth" --out "$work/small" --frames 1 --resolution 320x200 --focal 250 > /dev/null || fail "bundletrack_synth --resolution failed"
+for image in rgb/000000.png depth/000000.png masks/000000.png; do
+  size=$(od -An -tu1 -j16 -N8 "$work/small/$image" | awk '{print $3 * 256 + $4 "x" $7 * 256 + $8}')
+  [ "$size" = 320x200 ] || fail "$image is $size, not 320x200"
+done
+[ "$(tr -s ' \n' ' ' < "$work/small/cam_K.txt" | sed 's/ $//')" = "250 0 159.5 0 250 99.5 0 0 1" ] ||
+  fail "cam_K.txt of --resolution 320x200 --focal 250: $(cat "$work/small/cam_K.txt")"
 
 "$synth" --out "$work/seq" --frames 3 --shape mug --distance 0.8 > /dev/null || fail "a well-formed bundletrack_synth command line failed"
 refused "--sequence and --out are required" "$track" --sequence "$work/seq"
