@@ -7,7 +7,7 @@
 # where the object leaves the view). With --before, a
 # second build's tracker runs on the very same sequences and its columns stand beside.
 #
-# The design is sparse (59 synthetic cells, not the 144 of the full product), chosen so that each
+# The design is sparse (62 synthetic cells, not the 144 of the full product), chosen so that each
 # factor varies with the others held at their usual value:
 #   A  distance {0.5, 1, 2, 3 m} x object {mug 0.10 m, box 0.20 m, chair 0.70 m} x {textured,
 #      textureless}, structured light, normal speed (no chair at 0.5 m: it would not fit the view);
@@ -28,6 +28,9 @@
 #      stereo, 93 degrees (605 px, an Azure Kinect's 720p colour camera, depth mapped to it) with the
 #      textureless chair at 3 m under time of flight, and the 640x480 camera's 56 degrees at twice
 #      its pixels (1200 px) with the mug at 1 m.
+#   H  a time-of-flight camera's flying pixels (bundletrack_synth --flying-pixels 1: every depth-edge
+#      pixel that keeps a reading mixes the two surfaces' depths): box and mug at 1 m, textureless
+#      chair at 3 m.
 #
 # Usage: bash bench/accuracy_matrix.sh BUILD_DIR OUT_DIR [--before BUILD_DIR [--before-label TEXT]]
 #        [--config FILE] [--data DIR] [--frames N] [--markdown FILE]
@@ -99,6 +102,9 @@ done
 cells+=("G_box_1m_active_stereo_720p|--shape box --size 0.20 --distance 1 --sensor active_stereo --resolution 1280x720 --focal 674")
 cells+=("G_chair_3m_textureless_time_of_flight_720p|--shape chair --size 0.70 --distance 3 --textureless --sensor time_of_flight --resolution 1280x720 --focal 605")
 cells+=("G_mug_1m_720p|--shape mug --size 0.10 --distance 1 --resolution 1280x720")
+cells+=("H_box_1m_time_of_flight_flying_pixels|--shape box --size 0.20 --distance 1 --sensor time_of_flight --flying-pixels 1")
+cells+=("H_mug_1m_time_of_flight_flying_pixels|--shape mug --size 0.10 --distance 1 --sensor time_of_flight --flying-pixels 1")
+cells+=("H_chair_3m_textureless_time_of_flight_flying_pixels|--shape chair --size 0.70 --distance 3 --textureless --sensor time_of_flight --flying-pixels 1")
 
 tool() {  # build name -> path of the build's executable
   if [ -x "$1/bin/$2" ]; then echo "$1/bin/$2"; else echo "$1/$2"; fi
@@ -196,7 +202,8 @@ out = ["# Accuracy stress matrix", "",
        "where the object leaves the view (D_*_out_of_view). Cell names: A distance x object x texture,",
        "B sensor, C fast motion, D occlusion and out of view, E masks 3 px off the outline, F and",
        "real_*_propagated: the first frame's mask alone (--propagate-masks), G 1280x720 images at",
-       "other fields of view; see the script's header for the design."]
+       "other fields of view, H a time-of-flight camera's flying pixels; see the script's header for",
+       "the design."]
 if with_before:
     out.append(f"The before columns: {before_label}, on the same sequences.")
 out.append("")

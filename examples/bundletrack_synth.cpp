@@ -66,6 +66,12 @@ int main(int argc, char** argv) {
                                             "horizontal field of view, 56 degrees, at any width)")
       ->type_name("PX")
       ->check(bt::examples::positive());
+  command_line.add_option("--flying-pixels", settings.sensor.flying_pixels,
+                          "probability that a pixel at a depth edge reads a mix of the two surfaces'\n"
+                          "depths, as a time-of-flight camera's flying pixels do (0: none)")
+      ->type_name("P")
+      ->capture_default_str()
+      ->check(bt::examples::probability());
   command_line.add_flag("--no-noise", no_noise, "perfect sensor: no depth noise, quantisation, shadow, dropouts or colour noise");
   command_line.add_flag("--no-shadow", no_shadow, "no shadow: every surface the depth camera sees has a reading (before dropouts)");
   command_line.add_option("--objects", settings.objects, "1 | 2 | 3 objects, each carried by its own hand: beside the --shape the first\n"

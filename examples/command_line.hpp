@@ -81,4 +81,9 @@ inline CLI::Validator positive() {
   return numberCheck("> 0", false, [](double value) { return value > 0.0; });
 }
 
+/// A probability: a number in [0, 1].
+inline CLI::Validator probability() {
+  return numberCheck("in [0, 1]", false, [](double value) { return value >= 0.0 && value <= 1.0; });
+}
+
 }  // namespace bundletrack::examples

@@ -6,6 +6,7 @@
 #include <iterator>
 #include <numeric>
 
+#include "bundletrack/core/depth_filter.hpp"
 #include "bundletrack/io/rgbd_sequence.hpp"
 #include "bundletrack/synth/synthetic_sequence.hpp"
 #include "temp_dir.hpp"
@@ -248,6 +249,56 @@ TEST_CASE("a triangulating sensor's shadow: what its second viewpoint cannot see
   }
   depth.setTo(near);
   CHECK(cv::countNonZero(synth::shadowedPixels(depth, fx, baseline)) == 0);  // a plane facing the camera: none
+}
+
+TEST_CASE("a time-of-flight camera's flying pixels: the sensor mixes the two surfaces at a depth edge, the depth filter takes nearly all off") {
+  // A step: the right half at 1 m, the left half at 2 m; every edge pixel keeps its reading and
+  // reads a mix of the two depths.
+  const double near = 1.0, far = 2.0;
+  cv::Mat depth(kSize, CV_32FC1, cv::Scalar(far));
+  depth.colRange(320, kSize.width).setTo(near);
+  synth::RenderBuffers clean{depth, cv::Mat(kSize, CV_32SC1, cv::Scalar(0)), cv::Mat(kSize, CV_32FC3, cv::Scalar::all(0.5)),
+                             cv::Mat(kSize, CV_32FC3, cv::Scalar(0.0, 0.0, -1.0))};
+  synth::SensorSettings sensor = perfectSensor();
+  sensor.depth_noise = bt::DepthNoise::timeOfFlight();
+  sensor.flying_pixels = 1.0;
+  cv::Mat read, color;
+  synth::applySensorModel(clean, kCamera, sensor, 5, read, color);
+  // Readings more than 5 sigma (5 x 4.4 mm per metre) from their own surface.
+  const auto off_surface = [&](const cv::Mat& reading, double& mean_mix) {
+    int off = 0, edge = 0;
+    mean_mix = 0.0;
+    for (int v = 0; v < kSize.height; ++v)
+      for (int u = 0; u < kSize.width; ++u) {
+        const double z = reading.at<float>(v, u), truth = depth.at<float>(v, u);
+        if (z <= 0.0) continue;
+        off += std::abs(z - truth) > 5.0 * sensor.depth_noise.sigma(truth, kCamera.fx);
+        if (u == 319 || u == 320) {
+          mean_mix += (z - truth) / ((u == 319 ? near : far) - truth);
+          ++edge;
+        }
+      }
+    mean_mix /= std::max(edge, 1);
+    return off;
+  };
+  double mix = 0.0;
+  const int flying = off_surface(read, mix);
+  MESSAGE("flying pixels read: " << flying << ", mean mix " << mix);
+  // The two edge columns, 960 pixels, mixed by a uniform fraction (mean 1/2); a fraction within
+  // 5 sigma of either end (2-4 % of the 1 m gap) stays on its surface.
+  CHECK(flying > 850);
+  CHECK(flying <= 960);
+  CHECK(mix == doctest::Approx(0.5).epsilon(0.1));
+  // The filter's erosion: a flying pixel differs from most of its neighbours, on either surface
+  // and along the edge, by more than 3 sigma of two readings' difference. One whose neighbours
+  // along the edge happen to read within that of it stays (two of its five in the edge columns
+  // within 2.8 cm at 1.5 m: a few percent of them).
+  const cv::Mat filtered = bt::filterDepth(read, bt::DepthFilterSettings(), bt::NoiseScale(sensor.depth_noise, kCamera.fx));
+  const int kept = off_surface(filtered, mix);
+  MESSAGE("flying pixels after the depth filter: " << kept);
+  CHECK(kept <= 0.05 * flying);
+  // Nor does it take the surfaces: all but the edge columns and a few beside them remain.
+  CHECK(cv::countNonZero(filtered > 0.0f) >= (kSize.width - 6) * kSize.height);
 }
 
 TEST_CASE("the synthetic distance option places the camera that far from the object, hand-held and orbiting") {

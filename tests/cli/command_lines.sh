@@ -11,7 +11,7 @@ rm -rf "$work" && mkdir -p "$work"
 
 # --help: exit 0, every option listed.
 "$synth" --help > "$work/help.txt" || fail "bundletrack_synth --help: exit $?"
-for option in --out --frames --shape --size --distance --sensor --resolution --focal --out-of-view --objects --labels --seed --layout; do
+for option in --out --frames --shape --size --distance --sensor --resolution --focal --flying-pixels --out-of-view --objects --labels --seed --layout; do
   grep -q -- "$option" "$work/help.txt" || fail "bundletrack_synth --help does not list $option"
 done
 "$track" --help > "$work/help.txt" || fail "bundletrack_track --help: exit $?"
@@ -48,6 +48,7 @@ refused "--resolution 1280x: expected WIDTHxHEIGHT in pixels" "$synth" --out "$w
 refused "--resolution 1280x720x3: expected WIDTHxHEIGHT" "$synth" --out "$work/never" --resolution 1280x720x3
 refused "--resolution 32x24: expected WIDTHxHEIGHT in pixels, each from 64 to 8192" "$synth" --out "$work/never" --resolution 32x24
 refused "--focal: expects a number > 0, got '0'" "$synth" --out "$work/never" --focal 0
+refused "--flying-pixels: expects a number in [0, 1], got '1.5'" "$synth" --out "$work/never" --flying-pixels 1.5
 
 # --resolution and --focal: the images' size (a PNG's IHDR holds width and height at bytes 16-23)
 # and cam_K.txt's intrinsics, the principal point at the centre.

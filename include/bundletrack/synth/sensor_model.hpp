@@ -28,6 +28,10 @@ struct SensorSettings {
   double min_range = 0.2, max_range = 4.0;  ///< metres; outside: no reading
   double edge_jump = 0.01;  ///< metres; a 4-neighbour this much farther or closer marks a depth edge
   double edge_dropout = 0.6;  ///< probability that a depth-edge pixel has no reading
+  /// Probability that a depth-edge pixel with a reading reads a mix of the two surfaces it spans,
+  /// z + a (z_n - z) with a uniform in [0, 1) and z_n its 4-neighbour farthest in depth: the flying
+  /// pixels of a time-of-flight camera, whose pixel integrates light from both (0: none).
+  double flying_pixels = 0.0;
   double grazing_angle_deg = 78.0;  ///< no reading where the surface is seen more obliquely than this
   double random_dropout = 0.002;  ///< probability of a missing reading anywhere
   double color_noise = 2.0;  ///< grey levels, Gaussian per channel
@@ -73,7 +77,7 @@ inline cv::Mat shadowedPixels(const cv::Mat& depth, double fx, double baseline) 
 /// Deterministic for a given seed.
 inline void applySensorModel(const RenderBuffers& clean, const PinholeCamerad& camera, const SensorSettings& s,
                              unsigned seed, cv::Mat& depth, cv::Mat& color) {
-  std::mt19937 rng(seed);
+  std::mt19937 rng(seed), mixing_rng(seed ^ 0x5bd1e995u);  // flying pixels draw apart: other streams unchanged
   std::normal_distribution<double> gauss(0.0, 1.0);
   std::uniform_real_distribution<double> uniform(0.0, 1.0);
   const double cos_grazing = std::cos(radians(s.grazing_angle_deg));
@@ -86,17 +90,21 @@ inline void applySensorModel(const RenderBuffers& clean, const PinholeCamerad& c
       const double z = clean.depth.at<float>(v, u);
       if (z <= s.min_range || z >= s.max_range || dropout < s.random_dropout || shadowed.at<uchar>(v, u)) continue;
       bool edge = false;
+      double across = z;  // the 4-neighbour's depth farthest from z
       for (const auto& [dv, du] : {std::pair{0, 1}, {0, -1}, {1, 0}, {-1, 0}}) {
         const int vv = v + dv, uu = u + du;
         if (vv < 0 || uu < 0 || vv >= depth.rows || uu >= depth.cols) continue;
         const double zn = clean.depth.at<float>(vv, uu);
         edge |= zn <= 0.0 || std::abs(zn - z) > s.edge_jump;
+        if (zn > 0.0 && std::abs(zn - z) > std::abs(across - z)) across = zn;
       }
       if (edge && dropout < s.edge_dropout) continue;
       const cv::Vec3f& n = clean.normal.at<cv::Vec3f>(v, u);
       const Eigen::Vector3d ray = camera.unproject(u, v, 1.0).normalized();
       if (std::abs(ray.dot(Eigen::Vector3d(n[0], n[1], n[2]))) < cos_grazing) continue;
-      depth.at<float>(v, u) = float(s.depth_noise.quantised(z + s.depth_noise.sigma(z, camera.fx) * noise, camera.fx));
+      double read = z;
+      if (edge && s.flying_pixels > 0.0 && uniform(mixing_rng) < s.flying_pixels) read += uniform(mixing_rng) * (across - z);
+      depth.at<float>(v, u) = float(s.depth_noise.quantised(read + s.depth_noise.sigma(read, camera.fx) * noise, camera.fx));
     }
   }
   cv::Mat noisy = clean.color.clone();
