@@ -1005,11 +1005,13 @@ TEST_CASE("a frame whose followed keypoints' graph is refused keeps following's 
 
 namespace {
 
-/// A verifier that trusts a graph only with the surface alone behind it: no graph reached from
-/// RANSAC's pose is taken.
-struct TrustsSurfaceOnly {
-  bool accepts(const bt::PoseGraph&, bt::Evidence evidence) const { return evidence == bt::Evidence::SurfaceOnly; }
+/// A verifier that trusts a graph only with one kind of evidence behind it (SurfaceOnly: no graph
+/// reached from RANSAC's pose is taken).
+template <bt::Evidence kTrusted>
+struct TrustsOnly {
+  bool accepts(const bt::PoseGraph&, bt::Evidence evidence) const { return evidence == kTrusted; }
 };
+using TrustsSurfaceOnly = TrustsOnly<bt::Evidence::SurfaceOnly>;
 
 }  // namespace
 
@@ -1036,15 +1038,6 @@ TEST_CASE("a RANSAC pose on fewer inliers than chance gathers, its graph refused
   CHECK(few.score.rotation_error_deg < 1.0);
 }
 
-namespace {
-
-/// A verifier that trusts a graph only with a feature registration behind its start.
-struct TrustsFeaturesOnly {
-  bool accepts(const bt::PoseGraph&, bt::Evidence evidence) const { return evidence == bt::Evidence::Features; }
-};
-
-}  // namespace
-
 TEST_CASE("a frame whose keypoints find no pose with the last frame is verified as one with the surface alone behind it") {
   const ShortScene short_scene(12);
   bt::TrackerSettings settings;
@@ -1055,7 +1048,7 @@ TEST_CASE("a frame whose keypoints find no pose with the last frame is verified 
   // stricter test a surface-only graph had just failed (the 2 m box behind a pillar, 38 degrees
   // off) was passed on the second try.
   using BySurface = bt::Tracker<bt::DefaultEnergy, bt::PCG, StaleDescriptors, bt::GivenMasks, bt::Ransac, TrustsSurfaceOnly>;
-  using ByFeatures = bt::Tracker<bt::DefaultEnergy, bt::PCG, StaleDescriptors, bt::GivenMasks, bt::Ransac, TrustsFeaturesOnly>;
+  using ByFeatures = bt::Tracker<bt::DefaultEnergy, bt::PCG, StaleDescriptors, bt::GivenMasks, bt::Ransac, TrustsOnly<bt::Evidence::Features>>;
   const Run surface = track(BySurface(short_scene.camera(), settings), short_scene.scene, short_scene.model);
   const Run features = track(ByFeatures(short_scene.camera(), settings), short_scene.scene, short_scene.model);
   MESSAGE("no RANSAC pose: surface-only test " << surface.tracked << " tracked, " << surface.lost << " lost, ADD-S "
