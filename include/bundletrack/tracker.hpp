@@ -164,6 +164,9 @@ class Tracker {
     return ObservedObject({last_->surface.points, last_->T_cam_obj}, pool_, settings_.max_keyframes);
   }
 
+  /// The last good pose as a coarse pose, with nothing but the surface behind it.
+  CoarseEstimate fromLastGoodPose() const { return {last_->T_cam_obj, false, false, Evidence::SurfaceOnly, {}}; }
+
   /// Keypoints are searched where the object was last seen, or anywhere after it was lost.
   bool searchObject(FrameContext& ctx) {
     const std::optional<SE3d> guess = ctx.recovering ? std::nullopt : std::optional(last_->T_cam_obj);
@@ -186,7 +189,7 @@ class Tracker {
   bool trackBySurface(FrameContext& ctx) {
     if (settings_.keypoints != KeypointSchedule::OnDemand || ctx.recovering) return false;
     const cv::Mat search_region = ctx.masked.mask;
-    ctx.coarse = {last_->T_cam_obj, false, false, Evidence::SurfaceOnly, {}};
+    ctx.coarse = fromLastGoodPose();
     if (segmentObject(ctx) && geometricStability(makeNode(ctx).surface) >= settings_.min_surface_stability) {
       buildGraph(ctx);
       optimiseGraph(ctx);
@@ -276,7 +279,7 @@ class Tracker {
     if (ctx.recovering) return reacquisitionCandidates(ctx, std::move(from_last));
     if (ctx.result.inliers < settings_.min_inliers) {
       if (ctx.followed_reserve) ctx.detected_kept = ctx.features;
-      ctx.candidates.push_back({last_->T_cam_obj, false, false, Evidence::SurfaceOnly, {}});
+      ctx.candidates.push_back(fromLastGoodPose());
       return true;
     }
     ctx.candidates.push_back({from_last.T_second_first * last.T_cam_obj, true, true, Evidence::Features, std::move(from_last.inliers)});
@@ -285,7 +288,7 @@ class Tracker {
     // from it, the graph from the last good pose is tried on the surface's evidence before
     // RANSAC's pose is reported.
     if (ctx.result.inliers < settings_.recovery_min_inliers)
-      ctx.candidates.push_back({last_->T_cam_obj, false, false, Evidence::SurfaceOnly, {}});
+      ctx.candidates.push_back(fromLastGoodPose());
     return true;
   }
 
@@ -320,7 +323,7 @@ class Tracker {
         by_surface.push_back(std::move(coarse));
       }
     }
-    by_surface.push_back({last_->T_cam_obj, false, false, Evidence::SurfaceOnly, {}});
+    by_surface.push_back(fromLastGoodPose());
     const std::optional<Placement> moved = movedOntoObject(ctx.masked);
     if (moved) by_surface.push_back({moved->T_cam_obj, false, false, Evidence::SurfaceOnly, {}});
     by_surface.resize(std::min(by_surface.size(), std::size_t(std::max(0, settings_.recovery_surface_candidates))));
