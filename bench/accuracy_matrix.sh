@@ -31,11 +31,16 @@
 #   H  a time-of-flight camera's flying pixels (bundletrack_synth --flying-pixels 1: every depth-edge
 #      pixel that keeps a reading mixes the two surfaces' depths): box and mug at 1 m, textureless
 #      chair at 3 m.
+# The shared real sequences are tracked as they are, from their first mask alone, and derived as
+# held-out data may differ from them (bench/real_variants.py): at half and a third of their pixels
+# (the object 2.2 and 3.3 m away in pixel terms, with the depth noise of its true 1.1 m) and every
+# third frame (three times the motion between frames).
 #
 # Usage: bash bench/accuracy_matrix.sh BUILD_DIR OUT_DIR [--before BUILD_DIR [--before-label TEXT]]
-#        [--config FILE] [--data DIR] [--frames N] [--markdown FILE]
+#        [--config FILE] [--data DIR] [--frames N] [--only REGEX] [--markdown FILE]
 # (--config: YAML settings for the BUILD_DIR tracker instead of the defaults, e.g. another
-# features.type; the --before tracker always runs with its defaults.)
+# features.type; the --before tracker always runs with its defaults. --only: the cells whose
+# names match the extended regular expression, e.g. those a change can touch.)
 # (BUILD_DIR: a build tree or a folder holding bundletrack_track.) Sequences are generated once
 # into OUT_DIR/sequences; the --before runs are kept in OUT_DIR/runs/before and reused.
 # Mug cells also get the rotation error split by whether the handle is visible, with the visible
@@ -47,7 +52,7 @@ set -euo pipefail
 build=${1:?build directory}
 out=${2:?output directory}
 shift 2
-before="" before_label="the --before build" config="" data="$(dirname "$0")/../../shared/data/7scenes_objects" frames=100 markdown=""
+before="" before_label="the --before build" config="" only="" data="$(dirname "$0")/../../shared/data/7scenes_objects" frames=100 markdown=""
 while [ $# -gt 0 ]; do
   case "$1" in
     --before) before=$2; shift 2 ;;
@@ -56,6 +61,7 @@ while [ $# -gt 0 ]; do
     --data) data=$2; shift 2 ;;
     --frames) frames=$2; shift 2 ;;
     --markdown) markdown=$2; shift 2 ;;
+    --only) only=$2; shift 2 ;;
     *) echo "unknown option $1" >&2; exit 2 ;;
   esac
 done
@@ -157,6 +163,7 @@ echo "cell,options,$run_columns,before_${run_columns//,/,before_}" > "$csv_file"
 mug_csv="$out/mug_rotation.csv"
 mug_columns="visible_frames,R_err_visible_deg,hidden_frames,R_err_hidden_deg,again_frames,R_err_again_deg"
 echo "cell,$mug_columns,before_${mug_columns//,/,before_}" > "$mug_csv"
+selected() { [ -z "$only" ] || [[ $1 =~ $only ]]; }
 run_cell() {  # name options sequence [tracker options]
   local name=$1 options=$2 seq=$3 tracking=${4:-} after before_fields=",,,,,,,," mug_before=",,,,,"
   after=$(track "$build" "$seq" "$out/runs/after/$name" "" "$config" "$tracking")
@@ -174,19 +181,32 @@ for cell in "${cells[@]}"; do
   options=${cell#*|}
   tracking=""
   [[ $options == *"|"* ]] && tracking=${options#*|} && options=${options%%|*}
+  selected "$name" || continue
   seq="$out/sequences/$name"
   # shellcheck disable=SC2086
   [ -d "$seq/rgb" ] || "$(tool "$build" bundletrack_synth)" --out "$seq" --frames "$frames" $options > /dev/null
   run_cell "$name" "$options" "$seq" "$tracking"
 done
 for s in mug_1 magazines_1 container_1; do
-  [ -d "$data/$s" ] && run_cell "real_$s" "shared sequence" "$data/$s"
+  [ -d "$data/$s" ] && selected "real_$s" && run_cell "real_$s" "shared sequence" "$data/$s"
 done
 for s in mug_1 magazines_1 container_1; do
-  [ -d "$data/$s" ] && run_cell "real_${s}_propagated" "shared sequence" "$data/$s" --propagate-masks
+  [ -d "$data/$s" ] && selected "real_${s}_propagated" && run_cell "real_${s}_propagated" "shared sequence" "$data/$s" --propagate-masks
+done
+for s in mug_1 magazines_1 container_1; do
+  [ -d "$data/$s" ] || continue
+  for variant in "half_pixels|--scale 0.5|at half its pixels" "third_pixels|--scale 0.3333333|at a third of its pixels" \
+    "every_3rd_frame|--every 3|every third frame"; do
+    IFS='|' read -r suffix derive what <<< "$variant"
+    selected "real_${s}_$suffix" || continue
+    seq="$out/sequences/real_${s}_$suffix"
+    # shellcheck disable=SC2086
+    [ -d "$seq/rgb" ] || $py "$(dirname "$0")/real_variants.py" "$data/$s" "$seq" $derive
+    run_cell "real_${s}_$suffix" "shared sequence $what (real_variants.py $derive)" "$seq"
+  done
 done
 
-$py - "$csv_file" "$markdown" "$frames" "$mug_csv" "$([ -n "$before" ] && echo 1 || echo 0)" "$before_label" "$config" <<'PY'
+$py - "$csv_file" "$markdown" "$frames" "$mug_csv" "$([ -n "$before" ] && echo 1 || echo 0)" "$before_label" "$config" "$only" <<'PY'
 import csv, sys
 rows = list(csv.DictReader(open(sys.argv[1])))
 frames, mug_rows = sys.argv[3], list(csv.DictReader(open(sys.argv[4])))
@@ -202,10 +222,14 @@ out = ["# Accuracy stress matrix", "",
        "where the object leaves the view (D_*_out_of_view). Cell names: A distance x object x texture,",
        "B sensor, C fast motion, D occlusion and out of view, E masks 3 px off the outline, F and",
        "real_*_propagated: the first frame's mask alone (--propagate-masks), G 1280x720 images at",
-       "other fields of view, H a time-of-flight camera's flying pixels; see the script's header for",
-       "the design."]
+       "other fields of view, H a time-of-flight camera's flying pixels; real_*_half_pixels,",
+       "real_*_third_pixels, real_*_every_3rd_frame: the shared sequences as held-out data may differ",
+       "(bench/real_variants.py: the object 2.2 / 3.3 m away in pixel terms with its own depth noise,",
+       "three times the motion); see the script's header for the design."]
 if with_before:
     out.append(f"The before columns: {before_label}, on the same sequences.")
+if sys.argv[8]:
+    out.append(f"Only the cells whose names match `{sys.argv[8]}` (`--only`).")
 out.append("")
 
 
