@@ -100,8 +100,9 @@ class Tracker {
     if (!searchObject(ctx)) return lost(ctx);  // the object is out of sight
     if (!trackBySurface(ctx) && !trackByFollowing(ctx)) {
       detectKeypoints(ctx);
+      const FrameFeatures detected = ctx.features;  // the candidates below may cut them to their masks
       if (!estimateCoarsePose(ctx)) return lost(ctx);
-      if (!refineCoarsePose(ctx) && !refineFromFollowing(ctx)) return lost(ctx);
+      if (!refineCoarsePose(ctx) && !refineFromFollowing(ctx) && !reacquireAtOnce(ctx, detected)) return lost(ctx);
     }
     cutMaskWithFinalPose(ctx);
     admitKeyframe(ctx);
@@ -335,6 +336,22 @@ class Tracker {
     return !ctx.candidates.empty();
   }
 
+  /// A frame whose every candidate above was refused is not given up while the object may be in
+  /// view: the candidates of a re-acquisition (reacquisitionCandidates: keyframe registrations,
+  /// the last good pose moved onto the object's points and turned about them, decided together)
+  /// are tried on it at once, from the search region of a lost track, rather than on the next
+  /// frame. A jump the graph from the last good pose cannot follow (a small object moving fast)
+  /// then costs no frame; a frame without the object is lost as before. The object was at its
+  /// last good pose a frame ago, so a pose the surface alone holds must lie within the
+  /// candidates' reach of it (withinReach).
+  bool reacquireAtOnce(FrameContext& ctx, FrameFeatures detected) {
+    if (ctx.recovering) return false;  // those candidates were this frame's already
+    ctx.recovering = ctx.reacquiring_at_once = true;
+    ctx.features = std::move(detected);
+    ctx.candidates.clear();
+    return searchObject(ctx) && estimateCoarsePose(ctx) && refineCoarsePose(ctx);
+  }
+
   /// A pose placed on the points of a frame, and their centroid (camera frame).
   struct Placement {
     SE3d T_cam_obj;
@@ -385,6 +402,7 @@ class Tracker {
         if (takeGraphPose(ctx)) return true;
         continue;
       }
+      if (!withinReach(ctx)) continue;
       if (verifier_.accepts(ctx.graph, Evidence::SurfaceConsensus)) {
         reached.push_back(ctx.graph.poses.back());
         reached_from.push_back(k);
@@ -409,6 +427,17 @@ class Tracker {
       return false;
     }
     return optimiseFrom(ctx, chosen, features) && acceptPose(ctx);
+  }
+
+  /// Whether the graph's pose of a frame re-acquired at once lies within the candidates' reach:
+  /// turned from the last good pose by no more than the outermost turned start
+  /// (recovery_turn_rings x recovery_turn_step_deg). A surface-only graph that ends farther away
+  /// has left the search (a 10 cm mug 3 m away, whose surface holds no turn, was taken upside
+  /// down); after lost frames the object may come back turned any way, and every pose counts.
+  bool withinReach(const FrameContext& ctx) const {
+    return !ctx.reacquiring_at_once ||
+           rotationGeodesic(ctx.graph.poses.back().rotation(), last_->T_cam_obj.rotation()) <=
+               radians(settings_.recovery_turn_step_deg * settings_.recovery_turn_rings);
   }
 
   /// The graph of the current frame from one coarse pose (false: the object is not where it says),

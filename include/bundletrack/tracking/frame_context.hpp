@@ -35,7 +35,8 @@ struct FrameContext {
 
   const RgbdFrame& frame;
   int id;
-  bool recovering;  ///< the frames before were lost
+  bool recovering;  ///< the frames before were lost, or this one is re-acquired at once (next)
+  bool reacquiring_at_once = false;  ///< every candidate from the last good frame was refused (Tracker::reacquireAtOnce)
   RgbdFrame masked;  ///< the frame with the mask the stages work on (shares the image buffers)
   FrameFeatures features;  ///< detected; moves into `current` when the graph is built
   bool keypoints_detected = false;  ///< on this frame (not always with keypoints on demand)
