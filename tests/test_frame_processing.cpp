@@ -7,6 +7,7 @@
 #include <limits>
 #include <random>
 
+#include "bundletrack/core/disc_dilation.hpp"
 #include "bundletrack/core/frame_memory.hpp"
 #include "bundletrack/core/intensity_image.hpp"
 #include "bundletrack/core/rgbd_frame.hpp"
@@ -325,6 +326,25 @@ TEST_CASE("the intensity image drops shading and the background and holds each g
 }
 
 #if defined(__GLIBC__) && !defined(__SANITIZE_ADDRESS__)  // the sanitizers' allocator has no mallinfo2
+TEST_CASE("a mask dilated by a disc equals OpenCV's dilation by its elliptic structuring element") {
+  // Scattered pixels (a 1 among them: any non-zero is set), a blob and pixels on the image's border,
+  // so that discs are cut by the border and overlap; radii from none to larger than the image.
+  std::mt19937 random(7);
+  cv::Mat mask(60, 90, CV_8UC1, cv::Scalar(0));
+  for (int k = 0; k < 12; ++k) mask.at<uchar>(int(random() % 60), int(random() % 90)) = 255;
+  mask.at<uchar>(0, 89) = mask.at<uchar>(59, 0) = 255;
+  mask.at<uchar>(30, 40) = 1;
+  cv::circle(mask, {60, 20}, 6, cv::Scalar(255), cv::FILLED);
+  for (const int radius : {0, 1, 3, 8, 17, 40, 100}) {
+    CAPTURE(radius);
+    cv::Mat expected;
+    cv::dilate(mask, expected, cv::getStructuringElement(cv::MORPH_ELLIPSE, {2 * radius + 1, 2 * radius + 1}));
+    expected = expected > 0;
+    CHECK(cv::countNonZero(bt::dilatedByDisc(mask, radius) != expected) == 0);
+  }
+  CHECK(cv::countNonZero(bt::dilatedByDisc(cv::Mat::zeros(60, 90, CV_8UC1), 5)) == 0);
+}
+
 TEST_CASE("keepFreedFrameMemory serves a frame-sized block from the heap and keeps it when freed") {
   REQUIRE(bt::keepFreedFrameMemory());
   constexpr std::size_t kBlock = 16 << 20;  // two 640x480 point images

@@ -6,6 +6,8 @@
 #include <opencv2/core.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "bundletrack/core/disc_dilation.hpp"
+
 namespace bundletrack {
 
 /// The object's image region as the keypoint detector sees it (original code, paper IV-B): the
@@ -26,11 +28,7 @@ struct ObjectCrop {
 /// Returns an empty crop (gray.empty()) when the mask is empty.
 inline ObjectCrop makeObjectCrop(const cv::Mat& bgr, const cv::Mat& mask, int size, int dilation_px) {
   ObjectCrop crop;
-  cv::Mat dilated;  // a fresh buffer: dilating into a header that shares `mask` would overwrite the caller's mask
-  if (dilation_px > 0)
-    cv::dilate(mask, dilated, cv::getStructuringElement(cv::MORPH_ELLIPSE, {2 * dilation_px + 1, 2 * dilation_px + 1}));
-  else
-    dilated = mask;
+  const cv::Mat dilated = dilation_px > 0 ? dilatedByDisc(mask, dilation_px) : mask;
   const cv::Rect box = cv::boundingRect(dilated);
   if (box.area() == 0) return crop;
   const double side = std::max(box.width, box.height);

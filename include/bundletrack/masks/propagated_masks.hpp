@@ -7,6 +7,7 @@
 #include <opencv2/core.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "bundletrack/core/disc_dilation.hpp"
 #include "bundletrack/core/error.hpp"
 #include "bundletrack/core/image_region.hpp"
 #include "bundletrack/core/silhouette_image.hpp"
@@ -116,9 +117,8 @@ class PropagatedMasks {
   cv::Mat searchRegion(const RgbdFrame& frame, const ObservedObject& object, const std::optional<SE3d>& T_guess) const {
     requireStarted(frame);
     if (!T_guess) return objectSizedSurfaces(frame);
-    cv::Mat silhouette = renderDepth(object.surfaces(*T_guess), *T_guess, gridSize(frame.depth.size())) > 0.0f;
-    const int margin = (settings_.search_margin_px + grid_step_ - 1) / grid_step_;
-    cv::dilate(silhouette, silhouette, cv::getStructuringElement(cv::MORPH_ELLIPSE, {2 * margin + 1, 2 * margin + 1}));
+    cv::Mat silhouette = dilatedByDisc(renderDepth(object.surfaces(*T_guess), *T_guess, gridSize(frame.depth.size())) > 0.0f,
+                                       (settings_.search_margin_px + grid_step_ - 1) / grid_step_);
     cv::resize(silhouette, silhouette, frame.depth.size(), 0.0, 0.0, cv::INTER_NEAREST);
     return silhouette & (frame.depth > 0.0f);
   }
@@ -127,9 +127,7 @@ class PropagatedMasks {
     requireStarted(frame);
     cv::Mat rendered;
     cv::resize(renderDepth(object.surfaces(T_cam_obj), T_cam_obj, gridSize(frame.depth.size())), rendered, frame.depth.size(), 0.0, 0.0, cv::INTER_NEAREST);
-    cv::Mat region;
-    const int g = settings_.growth_px;
-    cv::dilate(rendered > 0.0f, region, cv::getStructuringElement(cv::MORPH_ELLIPSE, {2 * g + 1, 2 * g + 1}));
+    const cv::Mat region = dilatedByDisc(rendered > 0.0f, settings_.growth_px);
     const cv::Rect box = cv::boundingRect(region);
 
     // Candidates: valid depth near the silhouette, inside the hull; seeds: those that agree.
@@ -205,6 +203,7 @@ class PropagatedMasks {
   cv::Mat renderDepth(const std::vector<ObservedSurface>& object, const SE3d& T_cam_obj, cv::Size size) const {
     const PinholeCameraf grid = downsampledCamera(camera_, grid_step_);
     cv::Mat depth(size, CV_32FC1, cv::Scalar(0.0f));
+    cv::Rect drawn;  // the box of the cells drawn
     for (const ObservedSurface& surface : object) {
       const Eigen::Matrix<float, 3, 4> T = (T_cam_obj * surface.T_cam_obj.inverse()).matrix().topRows<3>().cast<float>();
       for (int y = 0; y < surface.points.rows; ++y) {
@@ -216,12 +215,14 @@ class PropagatedMasks {
           if (!grid.pixelOf(q, u, v) || u < 0 || v < 0 || u >= size.width || v >= size.height) continue;
           float& d = depth.at<float>(v, u);
           if (d == 0.0f || q.z() < d) d = q.z();
+          drawn |= cv::Rect(u, v, 1, 1);
         }
       }
     }
     cv::Mat closed = depth.clone();
-    for (int v = 0; v < size.height; ++v) {
-      for (int u = 0; u < size.width; ++u) {
+    const cv::Rect holes = grownWithin(drawn, 1, size);  // beyond it no cell has a drawn neighbour
+    for (int v = holes.y; v < holes.br().y; ++v) {
+      for (int u = holes.x; u < holes.br().x; ++u) {
         if (depth.at<float>(v, u) > 0.0f) continue;
         float nearest = 0.0f;
         int neighbours = 0;
