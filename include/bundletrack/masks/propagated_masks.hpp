@@ -219,6 +219,7 @@ class PropagatedMasks {
         }
       }
     }
+    if (drawn.empty()) return depth;
     cv::Mat closed = depth.clone();
     const cv::Rect holes = grownWithin(drawn, 1, size);  // beyond it no cell has a drawn neighbour
     for (int v = holes.y; v < holes.br().y; ++v) {
