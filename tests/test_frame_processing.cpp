@@ -325,7 +325,6 @@ TEST_CASE("the intensity image drops shading and the background and holds each g
   CHECK(next > 200);
 }
 
-#if defined(__GLIBC__) && !defined(__SANITIZE_ADDRESS__)  // the sanitizers' allocator has no mallinfo2
 TEST_CASE("a mask dilated by a disc equals OpenCV's dilation by its elliptic structuring element") {
   // Scattered pixels (a 1 among them: any non-zero is set), a blob and pixels on the image's border,
   // so that discs are cut by the border and overlap; radii from none to larger than the image.
@@ -345,6 +344,7 @@ TEST_CASE("a mask dilated by a disc equals OpenCV's dilation by its elliptic str
   CHECK(cv::countNonZero(bt::dilatedByDisc(cv::Mat::zeros(60, 90, CV_8UC1), 5)) == 0);
 }
 
+#if defined(__GLIBC__) && !defined(__SANITIZE_ADDRESS__)  // the sanitizers' allocator has no mallinfo2
 TEST_CASE("keepFreedFrameMemory serves a frame-sized block from the heap and keeps it when freed") {
   REQUIRE(bt::keepFreedFrameMemory());
   constexpr std::size_t kBlock = 16 << 20;  // two 640x480 point images
