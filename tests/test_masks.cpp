@@ -6,6 +6,7 @@
 #include "bundletrack/graph/keyframe.hpp"
 #include "bundletrack/core/angles.hpp"
 #include "bundletrack/masks/colour_likelihood.hpp"
+#include "bundletrack/masks/given_masks.hpp"
 #include "bundletrack/masks/propagated_masks.hpp"
 #include "bundletrack/masks/support_plane.hpp"
 #include "bundletrack/synth/synthetic_sequence.hpp"
@@ -34,6 +35,78 @@ TEST_CASE("depth segments: two planes split at their depth step, joined across t
   CHECK(segments[std::size_t(patch)].high.x() == doctest::Approx((49 - 39.5) * 1.5 / 500.0));
   // Without the widening the ramp's 2 cm steps split it into its 20 columns.
   CHECK(bt::segmentDepth(depth, points, 0.01f, bt::NoiseScale(bt::DepthNoise(), 500.0), labels).size() == 2 + 20);
+}
+
+TEST_CASE("a given mask drops the background it took in beside the object, and keeps what is before or within it") {
+  // A box face 1 m away before a wall at 1.6 m, a handle 5 cm before the face and reaching the
+  // mask's outline, a recess 30 cm deep inside the face, a few pixels without a reading; the mask
+  // is the face and the handle grown by 3 px onto the wall.
+  cv::Mat depth(60, 80, CV_32FC1, cv::Scalar(1.6f));
+  const cv::Rect face(20, 15, 30, 25), handle(50, 22, 6, 8), recess(30, 22, 6, 6);
+  depth(face).setTo(1.0f);
+  depth(handle).setTo(0.95f);
+  depth(recess).setTo(1.3f);
+  depth(cv::Rect(18, 30, 2, 3)).setTo(0.0f);
+  // Left of the face the wall is farther, and the depth filter cleared the column where the mask
+  // ends: that part reaches the outline across pixels without a reading.
+  depth(cv::Rect(0, face.y, face.x, face.height)).setTo(2.2f);
+  depth.col(17).setTo(0.0f);
+  cv::Mat object(depth.size(), CV_8UC1, cv::Scalar(0));
+  object(face).setTo(255);
+  object(handle).setTo(255);
+  cv::Mat given;
+  cv::dilate(object, given, cv::getStructuringElement(cv::MORPH_ELLIPSE, {7, 7}));
+  const bt::NoiseScale noise(bt::DepthNoise::structuredLight(), 500.0);
+  const cv::Mat kept = bt::withoutBackgroundSeenPast(given, depth, 0.01f, noise);
+  // Kept: the object and the grown pixels without a reading; the wall beside it goes.
+  const cv::Mat expected = object | (given & (depth == 0.0f));
+  CHECK(cv::countNonZero(kept != expected) == 0);
+  CHECK(cv::countNonZero(given & ~expected) > 200);
+  // Nothing to drop: the mask itself comes back.
+  CHECK(bt::withoutBackgroundSeenPast(object, depth, 0.01f, noise).data == object.data);
+  // A mask that is mostly background (a 3 x 3 px object grown by 6 px): the wall is its largest
+  // surface, and nothing is behind it.
+  cv::Mat speck(depth.size(), CV_8UC1, cv::Scalar(0)), grown;
+  speck(cv::Rect(60, 45, 3, 3)).setTo(255);
+  depth(cv::Rect(60, 45, 3, 3)).setTo(1.0f);
+  cv::dilate(speck, grown, cv::getStructuringElement(cv::MORPH_ELLIPSE, {13, 13}));
+  CHECK(cv::countNonZero(bt::withoutBackgroundSeenPast(grown, depth, 0.01f, noise) != grown) == 0);
+  // 3 m away a wall 5 cm behind the face is within the structured-light noise's widened step
+  // (1 cm x 7.5 there): one surface, kept; a sensor as precise as at 1 m tells them apart.
+  cv::Mat far_depth(depth.size(), CV_32FC1, cv::Scalar(3.05f));
+  far_depth(face).setTo(3.0f);
+  cv::Mat face_only(depth.size(), CV_8UC1, cv::Scalar(0)), face_given;
+  face_only(face).setTo(255);
+  cv::dilate(face_only, face_given, cv::getStructuringElement(cv::MORPH_ELLIPSE, {7, 7}));
+  CHECK(cv::countNonZero(bt::withoutBackgroundSeenPast(face_given, far_depth, 0.01f, noise) != face_given) == 0);
+  const cv::Mat precise = bt::withoutBackgroundSeenPast(face_given, far_depth, 0.01f, bt::NoiseScale(bt::DepthNoise(), 500.0));
+  CHECK(cv::countNonZero(precise != (face_given & (far_depth == 3.0f))) == 0);
+}
+
+TEST_CASE("a given mask grown onto the background keeps the renderer's true mask and little else, 3 m away") {
+  synth::SyntheticSequenceSettings settings;
+  settings.frames = 60;
+  settings.distance = 3.0;
+  settings.textureless = true;
+  const synth::SyntheticScene truth(settings);
+  settings.mask_error = synth::MaskError::Dilated;
+  settings.mask_error_px = 3;
+  const synth::SyntheticScene grown(settings);
+  const auto camera = settings.camera.cast<float>();
+  bt::GivenMasks masks;
+  for (const int k : {0, 20, 40, 59}) {
+    CAPTURE(k);
+    const synth::SyntheticFrame exact = truth.frame(k), f = grown.frame(k);
+    REQUIRE(cv::countNonZero(exact.depth != f.depth) == 0);
+    const bt::RgbdFrame frame = bt::makeFrame(std::to_string(k), f.color, f.depth, f.mask, camera);
+    const cv::Mat kept = masks.frameMask(frame);
+    const cv::Mat ring_read = f.mask & ~exact.mask & (frame.depth > 0.0f);
+    // Nothing of the object goes; of the grown ring's readings (the wall and table 0.5-1 m behind)
+    // at most a tenth stays: what is continuous with the object (the hand holding it) may.
+    CHECK(cv::countNonZero(exact.mask & ~kept) == 0);
+    CHECK(cv::countNonZero(ring_read) > 40);
+    CHECK(cv::countNonZero(ring_read & kept) <= cv::countNonZero(ring_read) / 10);
+  }
 }
 
 TEST_CASE("first view hull: the object's own surface is inside, points in front or beside it are not") {

@@ -69,9 +69,10 @@ class Tracker {
     clock_.start(&StageTimings::mask);
     TrackResult result;
     RgbdFrame masked = frame;  // shares the image buffers
-    grid_step_ = frame.mask.empty() ? settings_.dense_grid_step
-                                    : gridStepFor(frame, frame.mask, settings_.dense_target_samples, settings_.dense_grid_step);
-    masked.mask = result.mask = masks_.start(frame, camera_, T_cam_obj, grid_step_);
+    masked.mask = masks_.frameMask(frame);
+    grid_step_ = masked.mask.empty() ? settings_.dense_grid_step
+                                     : gridStepFor(masked, masked.mask, settings_.dense_target_samples, settings_.dense_grid_step);
+    masked.mask = result.mask = masks_.start(masked, camera_, T_cam_obj, grid_step_);
     clock_.enter(&StageTimings::features);
     FrameFeatures features = correspondences_.detect(masked);
     clock_.enter(&StageTimings::graph);
@@ -94,9 +95,12 @@ class Tracker {
   /// Paper IV, one frame: segment, keypoints, coarse pose from the last good frame (IV-B), pose
   /// graph over the selected keyframes (IV-C, IV-D), verification, keyframe admission (IV-E).
   /// With keypoints on demand the graph first runs without the frame's keypoints.
-  TrackResult track(const RgbdFrame& frame) {
-    if (!last_) throw InputError("frame " + frame.name, "track() called before initialize()");
-    FrameContext ctx = beginFrame(frame);
+  TrackResult track(const RgbdFrame& given) {
+    if (!last_) throw InputError("frame " + given.name, "track() called before initialize()");
+    clock_.start(&StageTimings::mask);
+    RgbdFrame frame = given;  // shares the image buffers; the mask as the source reads it
+    frame.mask = masks_.frameMask(given);
+    FrameContext ctx(frame, ++frame_index_, lost_streak_ > 0);
     if (!searchObject(ctx)) return lost(ctx);  // the object is out of sight
     if (!trackBySurface(ctx) && !trackByFollowing(ctx)) {
       detectKeypoints(ctx);
@@ -155,11 +159,6 @@ class Tracker {
     SurfaceGrid surface;
     KeypointFrame keypoints;
   };
-
-  FrameContext beginFrame(const RgbdFrame& frame) {
-    clock_.start(&StageTimings::mask);
-    return FrameContext(frame, ++frame_index_, lost_streak_ > 0);
-  }
 
   ObservedObject observed() const {
     return ObservedObject({last_->surface.points, last_->T_cam_obj}, pool_, settings_.max_keyframes);

@@ -28,6 +28,11 @@ inline OpenCvFeatureSource featureSource(const Config& config) {
   return SiftFeatures(config.sift);
 }
 
+/// Given masks drop their background over the same depth steps as propagated masks grow.
+inline GivenMaskSettings givenMaskSettings(const Config& config) {
+  return {config.drop_mask_background, config.propagated_masks.depth_continuity};
+}
+
 inline RansacSettings ransacSettings(const Config& config) {
   RansacSettings settings = config.ransac;
   settings.execution = config.execution;

@@ -30,7 +30,7 @@ std::unique_ptr<AnyTracker> gpuTracker(const Config& config, const PinholeCamera
   if (!cuda::deviceAvailable())
     throw std::runtime_error("compute.device is gpu, but no CUDA device is available (is the NVIDIA driver loaded?)");
   if (config.masks == "propagated") return gpuTrackerWith(config, camera, PropagatedMasks(config.propagated_masks));
-  return gpuTrackerWith(config, camera, GivenMasks());
+  return gpuTrackerWith(config, camera, GivenMasks(givenMaskSettings(config)));
 }
 
 }  // namespace bundletrack::runtime

@@ -44,7 +44,7 @@ std::unique_ptr<AnyTracker> makeTracker(const Config& config, const PinholeCamer
   }
   if (config.device == "gpu") return runtime::gpuTracker(config, camera);
   if (config.masks == "propagated") return runtime::cpuTracker(config, camera, PropagatedMasks(config.propagated_masks));
-  return runtime::cpuTracker(config, camera, GivenMasks());
+  return runtime::cpuTracker(config, camera, GivenMasks(runtime::givenMaskSettings(config)));
 }
 
 }  // namespace bundletrack

@@ -48,6 +48,7 @@ struct Config {
   double silhouette_weight = 1.0;  ///< lambda of the silhouette term (0: off)
   PCG pcg;
   std::string masks = "given";  ///< given | propagated
+  bool drop_mask_background = true;  ///< given masks: GivenMaskSettings::drop_background
   PropagatedMaskSettings propagated_masks;
   std::string device = "cpu";  ///< cpu | gpu
   Execution execution = Execution::Parallel;
@@ -227,10 +228,12 @@ inline std::vector<ConfigEntry> configEntries(Config& c) {
       {"solver", "pcg_tolerance", &c.pcg.tolerance, 0.0, 1.0, "", "PCG stops at this relative residual (the GPU's float PCG at 1e-6 at the least)"},
       {"masks", "source", textChoice(c.masks, {"given", "propagated"}), 0, 0, "",
        "given: every frame's mask from the data; propagated: from the first mask alone"},
+      {"masks", "background", enumChoice(c.drop_mask_background, {{"drop", true}, {"keep", false}}), 0, 0, "",
+       "given: drop: a surface of the mask that reaches its outline and lies wholly behind the mask's largest surface (beyond depth_continuity) is the background the mask took in beside the object, and leaves the mask; keep: the mask as given"},
       {"masks", "search_margin_px", &m.search_margin_px, 0, 10000, "px", "propagated: keypoints are searched this far around the last pose's silhouette"},
       {"masks", "growth_px", &m.growth_px, 0, 10000, "px", "propagated: the mask reaches this far beyond the rendered silhouette"},
       {"masks", "depth_agreement", &m.depth_agreement, 0.0, 1.0, "m", "propagated: observed vs rendered depth that seeds the mask"},
-      {"masks", "depth_continuity", &m.depth_continuity, 0.0, 1.0, "m", "propagated: largest depth step between neighbouring mask pixels (widened by the sensor's noise)"},
+      {"masks", "depth_continuity", &m.depth_continuity, 0.0, 1.0, "m", "largest depth step between neighbouring pixels of one surface (widened by the sensor's noise): propagated masks grow over such steps, given masks drop surfaces behind such a step"},
       {"masks", "hull_dilation_px", &m.hull_dilation_px, 0, 1000, "px", "propagated: slack of the first view's silhouette"},
       {"masks", "hull_depth_tolerance", &m.hull_depth_tolerance, 0.0, 1.0, "m", "propagated: slack in front of the first view's surface"},
       {"masks", "object_size_factor", &m.object_size_factor, 0.0, 100.0, "", "propagated, after lost: searched surfaces are at most this times the first view's extent"},

@@ -19,7 +19,10 @@ namespace bundletrack {
 /// renders what was seen (`object`) under them. Before the frame is preprocessed:
 /// - `regionOfInterest(image, given_mask, object, T_guess)`: the part of the image whose depth the
 ///   three calls below will read (given_mask: the frame's mask from the data, empty if none);
-/// then:
+/// then, once per frame:
+/// - `frameMask(frame)`: the frame's own mask as the source reads it (GivenMasks: the data's, less
+///   the background it took in beside the object; PropagatedMasks: as given, read at the start
+///   only); the calls below get the frame with this mask;
 /// - `start(first, camera, T_cam_obj, grid_step)`: the first frame and its pose; returns its mask;
 /// - `searchRegion(frame, object, T_guess)`: where to look for keypoints before the coarse pose is
 ///   known (std::nullopt: no idea where the object is, e.g. after it was lost);
@@ -30,6 +33,7 @@ concept MaskSource = requires(T& source, const T& const_source, const RgbdFrame&
                               const SE3d& pose, const ObservedObject& object, const std::optional<SE3d>& guess, int step,
                               cv::Size image, const cv::Mat& given_mask) {
   { const_source.regionOfInterest(image, given_mask, object, guess) } -> std::same_as<cv::Rect>;
+  { const_source.frameMask(frame) } -> std::same_as<cv::Mat>;
   { source.start(frame, camera, pose, step) } -> std::same_as<cv::Mat>;
   { const_source.searchRegion(frame, object, guess) } -> std::same_as<cv::Mat>;
   { const_source.mask(frame, object, pose) } -> std::same_as<cv::Mat>;

@@ -75,6 +75,9 @@ class PropagatedMasks {
 
   explicit PropagatedMasks(Settings settings = {}) : settings_(settings) {}
 
+  /// The frame's mask as given: only the first frame's is read.
+  cv::Mat frameMask(const RgbdFrame& frame) const { return frame.mask; }
+
   cv::Mat start(const RgbdFrame& first, const PinholeCameraf& camera, const SE3d& T_cam_obj, int grid_step) {
     if (first.mask.empty() || cv::countNonZero(first.mask) == 0)
       throw InputError("frame " + first.name, "propagated masks need a non-empty mask of the first frame");
