@@ -13,16 +13,16 @@
 namespace bundletrack {
 
 /// Where the object is in each frame (the paper's segmentation step). Masks are CV_8UC1, 255 on
-/// the object, all zero where it is not visible. The tracker asks three times per frame, giving
+/// the object, all zero where it is not visible. The tracker asks several times per frame, giving
 /// what it knows; a source whose masks exist independently of the track (GivenMasks: from the
 /// data or a segmentation network) ignores the poses, one that follows the object (PropagatedMasks)
 /// renders what was seen (`object`) under them. Before the frame is preprocessed:
 /// - `regionOfInterest(image, given_mask, object, T_guess)`: the part of the image whose depth the
-///   three calls below will read (given_mask: the frame's mask from the data, empty if none);
-/// then, once per frame:
-/// - `frameMask(frame)`: the frame's own mask as the source reads it (GivenMasks: the data's, less
-///   the background it took in beside the object; PropagatedMasks: as given, read at the start
-///   only); the calls below get the frame with this mask;
+///   calls below will read (given_mask: the frame's mask from the data, empty if none);
+/// then, with the preprocessed frame:
+/// - `frameMask(frame)`: first and once: the frame's own mask as the source reads it (GivenMasks:
+///   the data's, less the background it took in beside the object; PropagatedMasks: as given, read
+///   at the start only); the calls below get the frame with this mask;
 /// - `start(first, camera, T_cam_obj, grid_step)`: the first frame and its pose; returns its mask;
 /// - `searchRegion(frame, object, T_guess)`: where to look for keypoints before the coarse pose is
 ///   known (std::nullopt: no idea where the object is, e.g. after it was lost);
